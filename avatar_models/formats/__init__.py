@@ -1,0 +1,52 @@
+"""Motion file formats: BVH (read/write), CMU ASF/AMC (read), NPZ (avatarsim's own, read/write).
+
+``load_motion(path)`` picks the reader by extension; ``save_motion(motion, path)`` the writer.
+Every reader raises :class:`~avatar_models.errors.MotionFormatError` (with path and line) on
+malformed input and returns a ``Motion`` in metres, Z up.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from avatar_models.errors import MotionFormatError
+from avatar_models.motion import Motion
+
+READABLE = (".bvh", ".amc", ".npz")
+WRITABLE = (".bvh", ".npz")
+
+
+def load_motion(path: str | Path, **options) -> Motion:
+    """Read a motion file. ``options`` go to the format's reader (e.g. ``unit=``, ``asf=``)."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if not path.is_file():
+        raise MotionFormatError("no such file", path)
+    if suffix == ".bvh":
+        from avatar_models.formats.bvh import read_bvh
+
+        return read_bvh(path, **options)
+    if suffix == ".amc":
+        from avatar_models.formats.asf_amc import read_asf_amc
+
+        return read_asf_amc(path, **options)
+    if suffix == ".npz":
+        from avatar_models.formats.npz import read_npz
+
+        return read_npz(path, **options)
+    raise MotionFormatError(f"unknown motion format {suffix!r}; readable: {', '.join(READABLE)}", path)
+
+
+def save_motion(motion: Motion, path: str | Path, **options) -> Path:
+    """Write ``motion`` to ``path`` (by extension), atomically (temp file then rename)."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".bvh":
+        from avatar_models.formats.bvh import write_bvh
+
+        return write_bvh(motion, path, **options)
+    if suffix == ".npz":
+        from avatar_models.formats.npz import write_npz
+
+        return write_npz(motion, path, **options)
+    raise MotionFormatError(f"cannot write {suffix!r}; writable: {', '.join(WRITABLE)}", path)

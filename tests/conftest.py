@@ -1,0 +1,22 @@
+"""Shared fixtures. Real mocap lives in ../shared/mocap; tests that need it skip without it."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+
+MOCAP_DIR = Path(
+    os.environ.get("AVATARSIM_MOCAP", Path(__file__).resolve().parents[1].parent / "shared" / "mocap")
+)
+
+
+@pytest.fixture(scope="session")
+def mocap_dir() -> Path:
+    if not MOCAP_DIR.is_dir():
+        pytest.skip(f"real mocap folder {MOCAP_DIR} is absent")
+    return MOCAP_DIR
