@@ -36,7 +36,9 @@ LOWER = ("pelvis", "l_hip", "l_knee", "l_ankle", "l_foot", "r_hip", "r_knee", "r
 FEET = ("l_ankle", "l_foot", "r_ankle", "r_foot")
 
 # body17 is its own left/right mirror under this permutation.
-MIRROR = np.array([INDEX[n.replace("l_", "#").replace("r_", "l_").replace("#", "r_")] for n in BODY17])
+MIRROR = np.array(
+    [INDEX[n.replace("l_", "#").replace("r_", "l_").replace("#", "r_")] for n in BODY17]
+)
 
 
 def group_indices(names: tuple[str, ...]) -> np.ndarray:

@@ -115,7 +115,9 @@ class Motion:
             for level in _depth_levels(sk.parents):
                 par = sk.parents[level]
                 glob[:, level] = glob[:, par] @ local[:, level]
-                pos[:, level] = pos[:, par] + np.einsum("tjab,jb->tja", glob[:, par], sk.offsets[level])
+                pos[:, level] = pos[:, par] + np.einsum(
+                    "tjab,jb->tja", glob[:, par], sk.offsets[level]
+                )
             object.__setattr__(self, "_fk", (pos, glob))
         return self._fk  # type: ignore[attr-defined]
 
@@ -150,7 +152,7 @@ class Motion:
         if heading:
             fwd = self.fk()[1][:, j, :, 0]
             yaw = np.arctan2(fwd[:, 1], fwd[:, 0])
-            undo = Rotation.from_euler("z", -yaw).as_matrix()
+            undo = Rotation.from_euler("z", -yaw[:, None]).as_matrix()
             rel = np.einsum("tab,tjb->tja", undo, rel)
         return rel
 
@@ -182,7 +184,9 @@ class Motion:
         times = np.clip(np.asarray(times, dtype=float), 0.0, self.duration_s)
         if self.n_frames == 1:
             n = times.size
-            return self.replace(root_pos=np.repeat(self.root_pos, n, 0), local_rot=np.repeat(self.local_rot, n, 0))
+            return self.replace(
+                root_pos=np.repeat(self.root_pos, n, 0), local_rot=np.repeat(self.local_rot, n, 0)
+            )
         t = self.times
         root = np.stack([np.interp(times, t, self.root_pos[:, k]) for k in range(3)], axis=1)
         rot = np.empty((times.size, self.skeleton.n_joints, 4))

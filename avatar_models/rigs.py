@@ -64,7 +64,9 @@ def parse_rig(data: dict, source: str = "<rig>") -> Rig:
         offsets = np.array([j["offset"] for j in joints], dtype=float)
         is_site = np.array([bool(j.get("site", False)) for j in joints])
         limits = {
-            jn: {ax: (float(np.radians(lo)), float(np.radians(hi))) for ax, (lo, hi) in axes.items()}
+            jn: {
+                ax: (float(np.radians(lo)), float(np.radians(hi))) for ax, (lo, hi) in axes.items()
+            }
             for jn, axes in data.get("limits", {}).items()
         }
         skeleton = Skeleton(names, parents, offsets, is_site, limits, name=str(data["name"]))

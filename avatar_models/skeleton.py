@@ -77,7 +77,9 @@ class Skeleton:
             dup = sorted({x for x in names if names.count(x) > 1})
             raise MotionValueError(f"duplicate joint names: {dup}")
         if parents[0] != -1 or np.any(parents[1:] < 0) or np.any(parents[1:] >= np.arange(1, n)):
-            raise MotionValueError("parents must list the root first (-1) and each parent before its child")
+            raise MotionValueError(
+                "parents must list the root first (-1) and each parent before its child"
+            )
         if not np.all(np.isfinite(offsets)):
             raise MotionValueError("skeleton offsets contain NaN or inf")
         is_site = np.zeros(n, bool) if self.is_site is None else np.asarray(self.is_site, bool)
@@ -146,7 +148,12 @@ class Skeleton:
     def scaled(self, factor: float) -> Skeleton:
         """Uniformly scaled copy (offsets times ``factor``)."""
         return Skeleton(
-            self.names, self.parents, self.offsets * float(factor), self.is_site, self.limits, self.name
+            self.names,
+            self.parents,
+            self.offsets * float(factor),
+            self.is_site,
+            self.limits,
+            self.name,
         )
 
     def with_offsets(self, offsets: np.ndarray) -> Skeleton:

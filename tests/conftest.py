@@ -11,7 +11,9 @@ os.environ.setdefault("MUJOCO_GL", "egl")
 os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
 
 MOCAP_DIR = Path(
-    os.environ.get("AVATARSIM_MOCAP", Path(__file__).resolve().parents[1].parent / "shared" / "mocap")
+    os.environ.get(
+        "AVATARSIM_MOCAP", Path(__file__).resolve().parents[1].parent / "shared" / "mocap"
+    )
 )
 
 

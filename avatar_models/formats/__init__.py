@@ -34,7 +34,9 @@ def load_motion(path: str | Path, **options) -> Motion:
         from avatar_models.formats.npz import read_npz
 
         return read_npz(path, **options)
-    raise MotionFormatError(f"unknown motion format {suffix!r}; readable: {', '.join(READABLE)}", path)
+    raise MotionFormatError(
+        f"unknown motion format {suffix!r}; readable: {', '.join(READABLE)}", path
+    )
 
 
 def save_motion(motion: Motion, path: str | Path, **options) -> Path:

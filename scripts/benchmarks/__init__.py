@@ -1,4 +1,4 @@
-"""Benchmarks for ``avatarsim bench``. Each module here exposes ``run(quick=False) -> list[BenchRow]``.
+"""Benchmarks for ``avatarsim bench``: each module exposes ``run(quick=False) -> list[BenchRow]``.
 
 A row compares our implementation with a baseline timed in the same process (machines are
 noisy, so ratios are what we report), e.g. BVH parse MB/s next to a PyPI parser.
