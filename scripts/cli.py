@@ -1,0 +1,199 @@
+"""The ``avatarsim`` command line (typer). Exit codes: 0 ok, 1 a check failed, 2 bad input."""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import json
+import sys
+from collections.abc import Callable
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from avatar_models.errors import AvatarsimError
+
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    help="avatarsim: a MuJoCo-grounded simulation testbed for full-body VR avatars.",
+)
+console = Console()
+err_console = Console(stderr=True)
+
+JsonOpt = Annotated[Path | None, typer.Option("--json", help="Also write the result as JSON here.")]
+SeedOpt = Annotated[int, typer.Option("--seed", help="Seed for everything stochastic.")]
+
+
+def user_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """Turn avatarsim's typed errors into a one-line reason on stderr and exit code 2."""
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return fn(*args, **kwargs)
+        except AvatarsimError as exc:
+            err_console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
+            raise typer.Exit(2) from None
+
+    return wrapper
+
+
+def emit_json(path: Path | None, payload: dict[str, Any]) -> None:
+    if path is not None:
+        from scripts.results import write_json
+
+        write_json(path, payload)
+
+
+@app.command()
+@user_errors
+def info(
+    motion: Annotated[Path, typer.Argument(help="A .bvh, .amc (ASF beside it) or .npz file.")],
+    unit: Annotated[
+        str | None, typer.Option(help="File unit: cm, inch, m, cmu or metres per unit.")
+    ] = None,
+    seed: SeedOpt = 0,
+    json_out: JsonOpt = None,
+) -> None:
+    """Skeleton, fps, frames and size of a motion file."""
+    from avatar_models.formats import load_motion
+    from avatar_models.measure import standing_height
+
+    m = load_motion(motion, **_unit_option(unit))
+    payload = {
+        "path": str(motion),
+        "joints": m.skeleton.n_joints,
+        "joint_names": list(m.skeleton.names),
+        "fps": m.fps,
+        "frames": m.n_frames,
+        "duration_s": m.duration_s,
+        "height_m": standing_height(m),
+    }
+    table = Table(title=str(motion), show_header=False)
+    for key in ("joints", "fps", "frames", "duration_s", "height_m"):
+        value = payload[key]
+        table.add_row(key, f"{value:.3f}" if isinstance(value, float) else str(value))
+    console.print(table)
+    emit_json(json_out, payload)
+
+
+def _unit_option(unit: str | None) -> dict[str, Any]:
+    if unit is None:
+        return {}
+    try:
+        return {"unit": float(unit)}
+    except ValueError:
+        return {"unit": unit}
+
+
+@app.command()
+@user_errors
+def convert(
+    src: Annotated[Path, typer.Argument(help="Input .bvh, .amc or .npz.")],
+    dst: Annotated[Path, typer.Argument(help="Output .bvh or .npz.")],
+    fps: Annotated[float | None, typer.Option(help="Resample to this frame rate.")] = None,
+    unit: Annotated[str | None, typer.Option(help="Input unit (see `info`).")] = None,
+    seed: SeedOpt = 0,
+    json_out: JsonOpt = None,
+) -> None:
+    """Convert BVH / ASF+AMC / NPZ to BVH or NPZ, optionally resampled."""
+    from avatar_models.formats import load_motion, save_motion
+
+    m = load_motion(src, **_unit_option(unit))
+    if fps is not None:
+        m = m.resample(fps)
+    save_motion(m, dst)
+    console.print(f"wrote {dst}: {m.n_frames} frames at {m.fps:g} fps")
+    emit_json(json_out, {"src": str(src), "dst": str(dst), "frames": m.n_frames, "fps": m.fps})
+
+
+def _run(scenario_obj: Any, out: Path, json_out: Path | None) -> None:
+    from scripts.pipeline import run_scenario
+
+    results = run_scenario(scenario_obj, out, err_console)
+    table = Table(title=f"scenario {results['scenario']}")
+    for col in ("check", "value", "threshold", "passed"):
+        table.add_column(col)
+    for c in results["checks"]:
+        mark = "[green]yes[/]" if c["passed"] else "[red]NO[/]"
+        table.add_row(c["name"], f"{c['value']:.4g}", str(c["threshold"]), mark)
+    console.print(table)
+    console.print(f"results in {out}/ ({', '.join(sorted(results['outputs'].values()))})")
+    emit_json(json_out, results)
+    if not results["passed"]:
+        raise typer.Exit(1)
+
+
+@app.command()
+@user_errors
+def run(
+    scenario: Annotated[Path, typer.Argument(help="Scenario TOML file.")],
+    out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out/run"),
+    seed: Annotated[
+        int | None, typer.Option("--seed", help="Override the scenario's seed.")
+    ] = None,
+    json_out: JsonOpt = None,
+) -> None:
+    """Run a scenario: source -> devices -> methods -> checks. Exit 1 if a threshold fails."""
+    from scripts.scenario import load_scenario
+
+    sc = load_scenario(scenario)
+    if seed is not None:
+        sc = dataclasses.replace(sc, seed=seed)
+    _run(sc, out, json_out)
+
+
+@app.command()
+@user_errors
+def demo(
+    out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out/demo"),
+    seed: SeedOpt = 0,
+    json_out: JsonOpt = None,
+) -> None:
+    """The default scenario on built-in motion, end to end (results, pictures)."""
+    from scripts.scenario import DEFAULT_SCENARIO, load_scenario
+
+    sc = dataclasses.replace(load_scenario(DEFAULT_SCENARIO), seed=seed)
+    _run(sc, out, json_out)
+
+
+@app.command()
+@user_errors
+def bench(
+    name: Annotated[str | None, typer.Argument(help="One benchmark; all when omitted.")] = None,
+    quick: Annotated[bool, typer.Option(help="Smaller inputs, for a smoke run.")] = False,
+    seed: SeedOpt = 0,
+    json_out: JsonOpt = None,
+) -> None:
+    """Benchmarks: prints a table, writes JSON (name, unit, value, baseline, ratio)."""
+    from scripts.benchmarks import BENCHMARKS, run_benchmark
+
+    names = list(BENCHMARKS) if name is None else [name]
+    unknown = [n for n in names if n not in BENCHMARKS]
+    if unknown:
+        raise AvatarsimError(
+            f"unknown benchmark {unknown[0]!r}; available: {', '.join(BENCHMARKS)}"
+        )
+    rows = [row for n in names for row in run_benchmark(n, quick=quick)]
+    table = Table(title="avatarsim bench")
+    for col in ("name", "unit", "value", "baseline", "ratio"):
+        table.add_column(col, justify="right" if col != "name" else "left")
+    for r in rows:
+        base = "" if r.baseline is None else f"{r.baseline:.4g} ({r.baseline_name})"
+        ratio = "" if r.ratio is None else f"{r.ratio:.2f}x"
+        table.add_row(r.name, r.unit, f"{r.value:.4g}", base, ratio)
+    console.print(table)
+    payload = {"benchmarks": [r.to_json() for r in rows]}
+    emit_json(json_out or Path("out/bench/bench.json"), payload)
+
+
+def main() -> None:  # pragma: no cover - console entry point
+    app()
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(app())

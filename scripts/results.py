@@ -1,0 +1,87 @@
+"""Run results: the contract's JSON and JUnit XML for CI, both written atomically."""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import tempfile
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+from scripts.scenario import Threshold
+
+
+@dataclass(frozen=True)
+class CheckResult:
+    name: str
+    value: float
+    threshold: Threshold
+
+    @property
+    def passed(self) -> bool:
+        return self.threshold.passes(self.value)
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "name": self.name,
+            "value": self.value,
+            "threshold": self.threshold.max
+            if self.threshold.min is None
+            else self.threshold.describe(),
+            "passed": self.passed,
+        }
+
+
+def versions() -> dict[str, str]:
+    """Versions of the things that can change results."""
+    out = {"python": platform.python_version()}
+    for dist in ("avatarsim", "numpy", "scipy", "mujoco", "torch"):
+        try:
+            out[dist] = metadata.version(dist)
+        except metadata.PackageNotFoundError:
+            out[dist] = "absent"
+    return out
+
+
+def write_atomic(path: Path, data: bytes | str) -> Path:
+    """Write to a temp file in the same folder, then rename: readers never see half a file."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data.encode("utf-8") if isinstance(data, str) else data)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def write_json(path: Path, payload: dict[str, Any]) -> Path:
+    return write_atomic(path, json.dumps(payload, indent=2, sort_keys=False, default=float) + "\n")
+
+
+def junit_xml(suite: str, checks: list[CheckResult], time_s: float = 0.0) -> str:
+    """One testcase per check; a failed check carries a <failure> with value and threshold."""
+    failures = sum(not c.passed for c in checks)
+    root = ET.Element(
+        "testsuite",
+        name=suite,
+        tests=str(len(checks)),
+        failures=str(failures),
+        time=f"{time_s:.3f}",
+    )
+    for c in checks:
+        case = ET.SubElement(root, "testcase", classname=f"avatarsim.{suite}", name=c.name)
+        if not c.passed:
+            failure = ET.SubElement(
+                case, "failure", message=f"{c.value:.4g} not {c.threshold.describe()}"
+            )
+            failure.text = f"{c.name} = {c.value!r}, threshold {c.threshold.describe()}"
+    ET.indent(root)
+    return ET.tostring(root, encoding="unicode", xml_declaration=True) + "\n"

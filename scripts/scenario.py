@@ -1,0 +1,179 @@
+"""Scenario files (TOML): schema, validation with actionable errors, and thresholds.
+
+A scenario names a motion source, the body, the stages to run and pass/fail thresholds::
+
+    name = "default"
+    seed = 0
+    [motion]
+    source = "builtin"        # or a path to a .bvh / .amc / .npz file
+    activity = "walk"         # builtin only
+    duration_s = 4.0
+    fps = 90.0
+    [body]
+    mass_kg = 75.0
+    [report]
+    picture_frames = 6
+    [thresholds]              # metric = max allowed, or {min = x} / {max = x}
+    replay_error_mm_max = 1.0
+
+Unknown keys, wrong types and impossible values raise :class:`ScenarioError` naming the key.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+import types
+import typing
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from avatar_models.errors import AvatarsimError
+
+
+class ScenarioError(AvatarsimError):
+    """A scenario file is missing, malformed or asks for something impossible."""
+
+
+@dataclass(frozen=True)
+class MotionSpec:
+    source: str = "builtin"
+    activity: str = "walk"
+    duration_s: float = 4.0
+    fps: float = 90.0
+    height_m: float | None = None
+    unit: str | None = None
+
+
+@dataclass(frozen=True)
+class BodySpec:
+    mass_kg: float = 75.0
+    height_m: float | None = None
+
+
+@dataclass(frozen=True)
+class ReportSpec:
+    picture_frames: int = 6
+    gif: bool = True
+    gif_fps: float = 15.0
+
+
+@dataclass(frozen=True)
+class Threshold:
+    """Pass when ``value <= max`` (and/or ``value >= min``)."""
+
+    max: float | None = None
+    min: float | None = None
+
+    def passes(self, value: float) -> bool:
+        if value != value:  # NaN never passes
+            return False
+        return (self.max is None or value <= self.max) and (self.min is None or value >= self.min)
+
+    def describe(self) -> str:
+        parts = ([f"<= {self.max:g}"] if self.max is not None else []) + (
+            [f">= {self.min:g}"] if self.min is not None else []
+        )
+        return " and ".join(parts)
+
+
+@dataclass(frozen=True)
+class Scenario:
+    name: str = "scenario"
+    seed: int = 0
+    motion: MotionSpec = field(default_factory=MotionSpec)
+    body: BodySpec = field(default_factory=BodySpec)
+    report: ReportSpec = field(default_factory=ReportSpec)
+    thresholds: dict[str, Threshold] = field(default_factory=dict)
+    path: str | None = None
+
+
+def _check_type(value: Any, annotation: Any, where: str) -> Any:
+    """Coerce ints to floats where a float is expected; reject anything else of a wrong type."""
+    allowed = (
+        typing.get_args(annotation) if isinstance(annotation, types.UnionType) else (annotation,)
+    )
+    if value is None and type(None) in allowed:
+        return value
+    for typ in allowed:
+        if typ is float and isinstance(value, int | float) and not isinstance(value, bool):
+            return float(value)
+        if typ in (int, str, bool) and type(value) is typ:
+            return value
+    names = " or ".join(getattr(t, "__name__", str(t)) for t in allowed if t is not type(None))
+    raise ScenarioError(f"{where} must be {names}, got {value!r}")
+
+
+def _section(cls: type, table: Any, where: str) -> Any:
+    if not isinstance(table, dict):
+        raise ScenarioError(f"[{where}] must be a table")
+    hints = typing.get_type_hints(cls)
+    known = {f.name for f in dataclasses.fields(cls)}
+    unknown = sorted(set(table) - known)
+    if unknown:
+        raise ScenarioError(f"unknown key(s) {unknown} in [{where}]; allowed: {sorted(known)}")
+    return cls(**{k: _check_type(v, hints[k], f"{where}.{k}") for k, v in table.items()})
+
+
+def _threshold(name: str, raw: Any) -> Threshold:
+    if isinstance(raw, int | float) and not isinstance(raw, bool):
+        return Threshold(max=float(raw))
+    if isinstance(raw, dict) and raw and set(raw) <= {"min", "max"}:
+        t = _section(Threshold, raw, f"thresholds.{name}")
+        return t
+    raise ScenarioError(f"thresholds.{name} must be a number (max) or a table {{min=, max=}}")
+
+
+def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
+    """Validate a parsed TOML table into a :class:`Scenario`."""
+    top = {"name", "seed", "motion", "body", "report", "thresholds"}
+    unknown = sorted(set(data) - top)
+    if unknown:
+        raise ScenarioError(f"unknown top-level key(s) {unknown}; allowed: {sorted(top)}")
+    motion = _section(MotionSpec, data.get("motion", {}), "motion")
+    body = _section(BodySpec, data.get("body", {}), "body")
+    report = _section(ReportSpec, data.get("report", {}), "report")
+    if motion.duration_s <= 0 or motion.fps <= 0:
+        raise ScenarioError("motion.duration_s and motion.fps must be positive")
+    if motion.height_m is not None and not 1.0 <= motion.height_m <= 2.5:
+        raise ScenarioError(f"motion.height_m={motion.height_m} is not a human height in metres")
+    if body.mass_kg <= 0:
+        raise ScenarioError("body.mass_kg must be positive")
+    if report.picture_frames < 1:
+        raise ScenarioError("report.picture_frames must be at least 1")
+    thresholds_raw = data.get("thresholds", {})
+    if not isinstance(thresholds_raw, dict):
+        raise ScenarioError("[thresholds] must be a table")
+    thresholds = {k: _threshold(k, v) for k, v in thresholds_raw.items()}
+    return Scenario(
+        name=_check_type(data.get("name", "scenario"), str, "name"),
+        seed=_check_type(data.get("seed", 0), int, "seed"),
+        motion=motion,
+        body=body,
+        report=report,
+        thresholds=thresholds,
+        path=path,
+    )
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    path = Path(path)
+    if not path.is_file():
+        raise ScenarioError(f"scenario file {path} does not exist")
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
+        raise ScenarioError(f"{path}: not valid TOML ({exc})") from exc
+    scenario = parse_scenario(data, str(path))
+    source = scenario.motion.source
+    if source != "builtin" and not Path(source).is_absolute():
+        # Motion files are relative to the scenario file, so scenarios can travel with data.
+        resolved = (path.parent / source).resolve()
+        scenario = dataclasses.replace(
+            scenario, motion=dataclasses.replace(scenario.motion, source=str(resolved))
+        )
+    return scenario
+
+
+DEFAULT_SCENARIO = Path(__file__).parent / "scenarios" / "default.toml"
