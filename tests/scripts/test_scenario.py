@@ -1,0 +1,70 @@
+"""Scenario validation: clear ScenarioErrors for bad files; thresholds; results files."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+import pytest
+
+from scripts.results import CheckResult, junit_xml
+from scripts.scenario import (
+    DEFAULT_SCENARIO,
+    ScenarioError,
+    Threshold,
+    load_scenario,
+    parse_scenario,
+)
+
+
+def test_default_scenario_is_valid():
+    sc = load_scenario(DEFAULT_SCENARIO)
+    assert sc.motion.source == "builtin" and sc.thresholds
+
+
+@pytest.mark.parametrize(
+    "data, message",
+    [
+        ({"motoin": {}}, "unknown top-level key"),
+        ({"motion": {"activty": "walk"}}, r"unknown key\(s\) \['activty'\] in \[motion\]"),
+        ({"motion": {"fps": "fast"}}, "motion.fps must be float"),
+        ({"motion": {"duration_s": -1}}, "must be positive"),
+        ({"motion": {"height_m": 175}}, "not a human height in metres"),
+        ({"body": {"mass_kg": 0}}, "mass_kg must be positive"),
+        ({"seed": 1.5}, "seed must be int"),
+        ({"thresholds": {"x": "big"}}, "must be a number"),
+        ({"thresholds": {"x": {"maximum": 1}}}, "must be a number"),
+    ],
+)
+def test_invalid_scenarios_name_the_problem(data, message):
+    with pytest.raises(ScenarioError, match=message):
+        parse_scenario(data)
+
+
+def test_bad_toml_and_missing_file(tmp_path):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("name = [unclosed")
+    with pytest.raises(ScenarioError, match="not valid TOML"):
+        load_scenario(bad)
+    with pytest.raises(ScenarioError, match="does not exist"):
+        load_scenario(tmp_path / "nope.toml")
+
+
+def test_motion_path_is_relative_to_scenario(tmp_path):
+    f = tmp_path / "s.toml"
+    f.write_text('[motion]\nsource = "clips/walk.bvh"\n')
+    assert load_scenario(f).motion.source == str(tmp_path / "clips" / "walk.bvh")
+
+
+def test_threshold_semantics():
+    assert Threshold(max=1.0).passes(1.0) and not Threshold(max=1.0).passes(1.01)
+    assert Threshold(min=0.9).passes(0.95) and not Threshold(min=0.9).passes(0.5)
+    assert not Threshold(max=1.0).passes(float("nan"))
+
+
+def test_junit_xml_marks_failures():
+    checks = [CheckResult("a", 0.5, Threshold(max=1.0)), CheckResult("b", 2.0, Threshold(max=1.0))]
+    root = ET.fromstring(junit_xml("demo", checks))
+    assert root.get("tests") == "2" and root.get("failures") == "1"
+    cases = {c.get("name"): c for c in root.iter("testcase")}
+    assert cases["a"].find("failure") is None
+    assert "2" in cases["b"].find("failure").get("message")
