@@ -45,11 +45,10 @@ from scipy.spatial.transform import Rotation
 
 from avatar_models import quat
 from avatar_models.errors import MotionFormatError, MotionValueError
+from avatar_models.formats.units import UNITS, Y_UP_TO_Z_UP, unit_scale
 from avatar_models.motion import Motion
 from avatar_models.skeleton import Skeleton
 
-Y_UP_TO_Z_UP = np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
-INCH_M = 0.0254
 CMU_FPS = 120.0  # the CMU database is captured at 120 Hz; AMC files do not say.
 
 _SECTIONS = (":version", ":name", ":units", ":documentation", ":root", ":bonedata", ":hierarchy")
@@ -358,8 +357,8 @@ def read_asf(path: str | Path, unit: str | float = "asf") -> Asf:
 
     Args:
         path: the ``.asf`` file.
-        unit: ``"asf"`` to honour ``:units length`` (inches / length), or metres per file
-            length unit as a positive number.
+        unit: ``"asf"`` to honour ``:units length`` (inches / length), or a unit name of
+            :data:`~avatar_models.formats.units.UNITS` or metres per file unit.
     """
     path = Path(path)
     rows = _read_lines(path)
@@ -367,11 +366,9 @@ def read_asf(path: str | Path, unit: str | float = "asf") -> Asf:
     units = _parse_units(path, sections[":units"][1])
     to_rad = np.pi / 180.0 if units["angle"] == "deg" else 1.0
     if unit == "asf":
-        metres_per_unit = INCH_M / float(units["length"])
-    elif isinstance(unit, int | float) and np.isfinite(unit) and unit > 0:
-        metres_per_unit = float(unit)
+        metres_per_unit = UNITS["inch"] / float(units["length"])
     else:
-        raise MotionFormatError(f"unit must be 'asf' or metres per unit (> 0), got {unit!r}", path)
+        metres_per_unit = unit_scale(unit, path)
     root_order, root_axis, root_position = _parse_root(path, sections[":root"][1], to_rad)
     bones = _parse_bonedata(path, sections[":bonedata"][1], to_rad)
     parent = _parse_hierarchy(path, sections[":hierarchy"][1], bones)
@@ -585,7 +582,7 @@ def read_asf_amc(
     Args:
         amc_path: the ``.amc`` file.
         asf: the ``.asf`` file; by default found beside the AMC (:func:`find_asf`).
-        unit: ``"asf"`` (use the ASF's ``:units length``) or metres per file unit.
+        unit: ``"asf"`` (use the ASF's ``:units length``), a unit name or metres per unit.
         fps: frame rate; AMC files do not store one (CMU: 120).
 
     ``meta`` records ``source``, ``asf``, ``format``, ``metres_per_unit``, ``first_frame``,
