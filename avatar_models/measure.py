@@ -63,11 +63,14 @@ def standing_height(subject: Motion | Skeleton) -> float:
         return float(rest_z.max() - rest_z.min())
     j = {b: sk.index(n) for b, n in rig.body17.items()}
     leg = 0.5 * sum(
-        path_length(sk, j[f"{s}_hip"], j[f"{s}_knee"]) + path_length(sk, j[f"{s}_knee"], j[f"{s}_ankle"])
+        path_length(sk, j[f"{s}_hip"], j[f"{s}_knee"])
+        + path_length(sk, j[f"{s}_knee"], j[f"{s}_ankle"])
         for s in ("l", "r")
     )
     rest = sk.rest_positions()
-    hip_drop = float(np.linalg.norm(0.5 * (rest[j["l_hip"]] + rest[j["r_hip"]]) - rest[j["pelvis"]]))
+    hip_drop = float(
+        np.linalg.norm(0.5 * (rest[j["l_hip"]] + rest[j["r_hip"]]) - rest[j["pelvis"]])
+    )
     trunk = path_length(sk, j["pelvis"], j["neck"])
     neck_to_head = path_length(sk, j["neck"], j["head"])
     ankle_to_head = leg + hip_drop + trunk + neck_to_head

@@ -9,9 +9,9 @@ Reading gives a :class:`Motion` in metres, Z up, rest pose facing +X:
 - Root translation: ``Motion.root_pos`` is the root's OFFSET plus its position channels.
   Position channels of other joints *replace* their OFFSET (the Bandai Namco convention, see
   ``shared/mocap/README.md``). The core model translates the root only, so constant position
-  channels become the joint's offset; a static root whose single child carries the
-  translation (Bandai's ``joint_Root`` -> ``Hips``) is folded: the root follows the child
-  (their bone becomes zero-length) and every other joint keeps its position. Anything else
+  channels become the joint's offset; a root that does not rotate and whose single child
+  carries the translation (Bandai's ``joint_Root`` -> ``Hips``) is folded: the root follows
+  the child (their bone becomes zero-length) and every other joint keeps its position. Anything else
   raises :class:`MotionFormatError`.
 - Units: ``unit`` is a name in :data:`units.UNITS` or metres per unit; ``None`` picks the
   unit that gives a human standing height (:func:`measure.standing_height`).
@@ -67,7 +67,7 @@ class _Tokens:
         self.items = [(tok, n + 1) for n, ln in enumerate(text.split("\n")) for tok in ln.split()]
         self.pos = 0
         self.path = path
-        self.last_line = max(1, text.count("\n"))
+        self.last_line = text.count("\n") + 1  # the MOTION line
 
     def error(self, message: str, line: int | None = None) -> MotionFormatError:
         return MotionFormatError(message, self.path, line or self.last_line)
@@ -176,11 +176,15 @@ def _header_line(text: str, start: int, path: Path, line: int) -> tuple[list[str
         start, line = end + 1, line + 1
 
 
-def _motion_header(text: str, start: int, first_line: int, path: Path) -> tuple[int, float, int, int]:
+def _motion_header(
+    text: str, start: int, first_line: int, path: Path
+) -> tuple[int, float, int, int]:
     """Frames and Frame Time; returns (frames, frame_time, data_start, data_first_line)."""
     tokens, line, start = _header_line(text, start, path, first_line)
     if len(tokens) != 2 or tokens[0] != "Frames:" or not tokens[1].isdigit() or int(tokens[1]) < 1:
-        raise MotionFormatError(f"expected 'Frames: N' with N >= 1, found {' '.join(tokens)!r}", path, line)
+        raise MotionFormatError(
+            f"expected 'Frames: N' with N >= 1, found {' '.join(tokens)!r}", path, line
+        )
     frames = int(tokens[1])
     tokens, line, start = _header_line(text, start, path, line + 1)
     frame_time = float("nan")
@@ -196,7 +200,9 @@ def _motion_header(text: str, start: int, first_line: int, path: Path) -> tuple[
     return frames, frame_time, start, line + 1
 
 
-def _motion_values(data: str, frames: int, n_channels: int, path: Path, first_line: int) -> np.ndarray:
+def _motion_values(
+    data: str, frames: int, n_channels: int, path: Path, first_line: int
+) -> np.ndarray:
     """``(frames, n_channels)`` floats of the frame lines, validated line by line (vectorised)."""
     raw = np.frombuffer(data.encode("utf-8"), dtype=np.uint8)
     space = np.isin(raw, _WHITESPACE)
@@ -230,15 +236,21 @@ def _motion_values(data: str, frames: int, n_channels: int, path: Path, first_li
                 try:
                     float(t)
                 except ValueError:
-                    raise MotionFormatError(f"{t!r} is not a number", path, first_line + k) from None
+                    raise MotionFormatError(
+                        f"{t!r} is not a number", path, first_line + k
+                    ) from None
         raise MotionFormatError("unreadable frame data", path, first_line) from None
     if values.size != frames * n_channels:  # str.split knows more whitespace than the byte count
-        raise MotionFormatError("frame data contains unexpected whitespace characters", path, first_line)
+        raise MotionFormatError(
+            "frame data contains unexpected whitespace characters", path, first_line
+        )
     values = values.reshape(frames, n_channels)
     finite = np.isfinite(values).all(axis=1)
     if not finite.all():
         bad = int(np.argmin(finite))
-        raise MotionFormatError("NaN or infinite value in frame data", path, first_line + int(rows[bad]))
+        raise MotionFormatError(
+            "NaN or infinite value in frame data", path, first_line + int(rows[bad])
+        )
     return values
 
 
@@ -297,16 +309,16 @@ def _root_and_offsets(
         if _is_constant(pos):
             offsets[j] = pos.mean(axis=0)
             continue
-        root_static = _is_constant(values[:, : len(root.channels)]) if root.channels else True
+        root_turns = not _is_constant(rot[:, 0].reshape(-1, 9))
         only_child = [k for k in range(len(joints)) if joints[k].parent == 0] == [j]
-        if joints[j].parent == 0 and root_static and only_child:
-            root_pos = root_pos[0] + pos @ rot[0, 0].T
+        if joints[j].parent == 0 and not root_turns and only_child:
+            root_pos = root_pos + pos @ rot[0, 0].T
             offsets[j] = 0.0
             folded = joints[j].name
             continue
         raise MotionFormatError(
             f"joint {joints[j].name!r} has moving position channels; only the root (or the single "
-            "child of a static root) may translate",
+            "child of a root that does not rotate) may translate",
             path,
             joints[j].line,
         )
@@ -346,7 +358,9 @@ def read_bvh(path: str | Path, unit: str | float | None = None, up: str = "y") -
     motion_line = text.count("\n", 0, found.start()) + 1
     if n_channels == 0:
         raise MotionFormatError("the hierarchy declares no channels", path, motion_line)
-    frames, frame_time, start, first_line = _motion_header(text, found.end() + 1, motion_line + 1, path)
+    frames, frame_time, start, first_line = _motion_header(
+        text, found.end() + 1, motion_line + 1, path
+    )
     values = _motion_values(text[start:], frames, n_channels, path, first_line)
     positions, rot = _split_channels(joints, values)
     root_pos, offsets, folded = _root_and_offsets(joints, positions, rot, values, path)
@@ -410,10 +424,18 @@ def _hierarchy_text(skeleton: Skeleton, offsets: np.ndarray, order: list[int], e
         else:
             rot_channels = " ".join(f"{a}rotation" for a in euler)
             if p < 0:
-                header, channels = f"ROOT {skeleton.names[j]}", f"6 Xposition Yposition Zposition {rot_channels}"
+                header, channels = (
+                    f"ROOT {skeleton.names[j]}",
+                    f"6 Xposition Yposition Zposition {rot_channels}",
+                )
             else:
                 header, channels = f"JOINT {skeleton.names[j]}", f"3 {rot_channels}"
-            out += [f"{pad}{header}", f"{pad}{{", f"{pad}\tOFFSET {off}", f"{pad}\tCHANNELS {channels}"]
+            out += [
+                f"{pad}{header}",
+                f"{pad}{{",
+                f"{pad}\tOFFSET {off}",
+                f"{pad}\tCHANNELS {channels}",
+            ]
         open_depths.append(int(depth[j]))
     out += ["\t" * d + "}" for d in reversed(open_depths)]
     return "\n".join(out) + "\n"
@@ -436,7 +458,11 @@ def write_bvh(
     if up not in ("y", "z"):
         raise MotionValueError(f"up must be 'y' or 'z', got {up!r}")
     sites = np.flatnonzero(sk.is_site)
-    if sk.is_site[0] or any(sk.children(int(j)).size for j in sites) or np.any(sk.is_site[sk.parents[sites]]):
+    if (
+        sk.is_site[0]
+        or any(sk.children(int(j)).size for j in sites)
+        or np.any(sk.is_site[sk.parents[sites]])
+    ):
         raise MotionValueError("BVH needs end sites as leaves under non-site joints")
     scale = unit_scale(unit, path)
     axes = Y_UP_TO_Z_UP.T if up == "y" else np.eye(3)  # world -> file
