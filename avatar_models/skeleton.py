@@ -26,6 +26,7 @@ _SIDE_PATTERNS: tuple[tuple[str, str], ...] = (
     (r"^l(?=[a-z])", "^r(?=[a-z])"),
     (r" L ", " R "),
     (r"\.L$", r"\.R$"),
+    (r"_LEFT$", "_RIGHT$"),  # Azure Kinect k4abt names (CLAVICLE_LEFT)
 )
 
 
