@@ -11,6 +11,9 @@ from avatar_models.rigs import available_rigs, identify_rig, load_rig
 from avatar_models.skeleton import Skeleton
 
 RIGS = available_rigs()
+# bandai.toml documents a rest pose that is not upright (bones along local X; the motion stands
+# the body up), so rest-pose geometry is checked on the others only.
+UPRIGHT_RIGS = [r for r in RIGS if r != "bandai"]
 SIDES = [(b, "r_" + b[2:]) for b in BODY17 if b.startswith("l_")]
 
 
@@ -39,7 +42,7 @@ def test_rig_left_right_pairs(name):
         assert m[sk.index(body17[left])] == sk.index(body17[right]), (left, right)
 
 
-@pytest.mark.parametrize("name", RIGS)
+@pytest.mark.parametrize("name", UPRIGHT_RIGS)
 def test_rig_rest_pose_upright_left_is_y(name):
     """Z up: head above pelvis above ankles; left of the body is +Y."""
     rig = load_rig(name)
