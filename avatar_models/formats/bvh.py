@@ -43,7 +43,6 @@ from avatar_models.motion import Motion
 from avatar_models.skeleton import Skeleton
 
 _CHANNELS = {f"{a}{kind}": (kind, a) for a in "XYZ" for kind in ("position", "rotation")}
-_WHITESPACE = np.frombuffer(b" \t\n\r\v\f", dtype=np.uint8)
 _MOTION_LINE = re.compile(r"^[ \t]*MOTION[ \t\r]*$", re.MULTILINE)
 # Position channels whose peak-to-peak is below this fraction of their magnitude are constant
 # (files print about 6 significant digits, so "constant" values jitter in the last digit).
@@ -205,10 +204,10 @@ def _motion_values(
 ) -> np.ndarray:
     """``(frames, n_channels)`` floats of the frame lines, validated line by line (vectorised)."""
     raw = np.frombuffer(data.encode("utf-8"), dtype=np.uint8)
-    space = np.isin(raw, _WHITESPACE)
-    starts = ~space & np.concatenate([[True], space[:-1]])
-    line_of = np.cumsum(raw == 10)
-    per_line = np.bincount(line_of[starts], minlength=int(line_of[-1]) + 1 if raw.size else 1)
+    space = raw <= 32  # ASCII whitespace and control bytes separate values
+    token_starts = np.flatnonzero(~space & np.concatenate([[True], space[:-1]]))
+    newlines = np.flatnonzero(raw == 10)
+    per_line = np.bincount(np.searchsorted(newlines, token_starts), minlength=newlines.size + 1)
     rows = np.flatnonzero(per_line)
     if rows.size < frames:
         last = first_line + (int(rows[-1]) if rows.size else 0)
@@ -227,9 +226,8 @@ def _motion_values(
             path,
             first_line + int(wrong[0]),
         )
-    tokens = data.split()
     try:
-        values = np.array(tokens, dtype=float)
+        values = np.fromstring(data, sep=" ")  # C parser; raises on any non-number
     except ValueError:
         for k, ln in enumerate(data.split("\n")):
             for t in ln.split():
@@ -241,9 +239,7 @@ def _motion_values(
                     ) from None
         raise MotionFormatError("unreadable frame data", path, first_line) from None
     if values.size != frames * n_channels:  # str.split knows more whitespace than the byte count
-        raise MotionFormatError(
-            "frame data contains unexpected whitespace characters", path, first_line
-        )
+        raise MotionFormatError("frame data contains unexpected characters", path, first_line)
     values = values.reshape(frames, n_channels)
     finite = np.isfinite(values).all(axis=1)
     if not finite.all():
@@ -255,15 +251,17 @@ def _motion_values(
 
 
 def _split_channels(joints: list[_Joint], values: np.ndarray) -> tuple[list, np.ndarray]:
-    """Per joint: its position ``(T, 3)`` (None without position channels) and ``(T, 3, 3)``
-    local rotation matrices, grouped by Euler order for vectorised scipy calls."""
+    """Per joint: its position ``(T, 3)`` (None without position channels), and the local
+    rotations ``(T, J, 4)`` wxyz, composed as intrinsic Euler rotations in channel order
+    (``q = q1 q2 q3``) in one vectorised pass over all joints (up to 3 slots, identity-padded).
+    """
     n_frames = values.shape[0]
-    rot = np.broadcast_to(np.eye(3), (n_frames, len(joints), 3, 3)).copy()
+    slot_col = np.full((len(joints), 3), -1)
+    slot_axis = np.zeros((len(joints), 3), dtype=int)
     positions: list[np.ndarray | None] = []
-    by_order: dict[str, list[tuple[int, list[int]]]] = {}
     col = 0
     for j, joint in enumerate(joints):
-        pos, order, rcols = None, "", []
+        pos, k = None, 0
         for name in joint.channels:
             kind, axis = _CHANNELS[name]
             if kind == "position":
@@ -271,17 +269,20 @@ def _split_channels(joints: list[_Joint], values: np.ndarray) -> tuple[list, np.
                     pos = np.broadcast_to(joint.offset, (n_frames, 3)).copy()
                 pos[:, "XYZ".index(axis)] = values[:, col]
             else:
-                order += axis
-                rcols.append(col)
+                slot_col[j, k], slot_axis[j, k] = col, "XYZ".index(axis)
+                k += 1
             col += 1
         positions.append(pos)
-        if order:
-            by_order.setdefault(order, []).append((j, rcols))
-    for order, items in by_order.items():
-        idx = [j for j, _ in items]
-        angles = values[:, [c for _, cols in items for c in cols]].reshape(-1, len(order))
-        mats = Rotation.from_euler(order, angles, degrees=True).as_matrix()
-        rot[:, idx] = mats.reshape(n_frames, len(idx), 3, 3)
+    half = np.where(slot_col >= 0, np.radians(values[:, slot_col]) * 0.5, 0.0)  # (T, J, 3)
+    elementary = np.zeros((n_frames, len(joints), 3, 4))
+    elementary[..., 0] = np.cos(half)
+    np.put_along_axis(
+        elementary[..., 1:],
+        np.broadcast_to(slot_axis[None, :, :, None], half.shape + (1,)),
+        np.sin(half)[..., None],
+        axis=-1,
+    )
+    rot = quat.mul(quat.mul(elementary[:, :, 0], elementary[:, :, 1]), elementary[:, :, 2])
     return positions, rot
 
 
@@ -294,7 +295,10 @@ def _is_constant(a: np.ndarray) -> bool:
 def _root_and_offsets(
     joints: list[_Joint], positions: list, rot: np.ndarray, values: np.ndarray, path: Path
 ) -> tuple[np.ndarray, np.ndarray, str]:
-    """Root trajectory ``(T, 3)``, offsets ``(J, 3)`` (file units) and the folded joint's name."""
+    """Root trajectory ``(T, 3)``, offsets ``(J, 3)`` (file units) and the folded joint's name.
+
+    ``rot (T, J, 4)``: local rotations in the file's axes.
+    """
     offsets = np.array([j.offset for j in joints])
     root = joints[0]
     root_pos = np.broadcast_to(root.offset, (values.shape[0], 3)).copy()
@@ -309,10 +313,10 @@ def _root_and_offsets(
         if _is_constant(pos):
             offsets[j] = pos.mean(axis=0)
             continue
-        root_turns = not _is_constant(rot[:, 0].reshape(-1, 9))
+        root_turns = not _is_constant(rot[:, 0])
         only_child = [k for k in range(len(joints)) if joints[k].parent == 0] == [j]
         if joints[j].parent == 0 and not root_turns and only_child:
-            root_pos = root_pos + pos @ rot[0, 0].T
+            root_pos = root_pos + quat.rotate(rot[0, 0], pos)
             offsets[j] = 0.0
             folded = joints[j].name
             continue
@@ -367,7 +371,7 @@ def read_bvh(path: str | Path, unit: str | float | None = None, up: str = "y") -
 
     axes = Y_UP_TO_Z_UP if up == "y" else np.eye(3)
     offsets, root_pos = offsets @ axes.T, root_pos @ axes.T
-    rot = axes @ rot @ axes.T
+    rot = np.concatenate([rot[..., :1], rot[..., 1:] @ axes.T], axis=-1)  # C R C^T
     names = [j.name for j in joints]
     parents = [j.parent for j in joints]
     is_site = [j.is_site for j in joints]
@@ -391,7 +395,7 @@ def read_bvh(path: str | Path, unit: str | float | None = None, up: str = "y") -
             skeleton.scaled(scale),
             _snap_fps(frame_time),
             root_pos * scale,
-            quat.from_matrix(rot),
+            rot,
             meta,
         )
     except MotionValueError as exc:

@@ -98,9 +98,13 @@ def _elementary(axis: str, deg: float) -> np.ndarray:
 def test_channel_order_is_intrinsic_euler_order(tmp_path, order):
     angles = [31.0, -47.0, 12.5][: len(order)]
     channels = " ".join(f"{a}rotation" for a in order)
-    text = TWO_JOINT.replace("CHANNELS 3 Zrotation Xrotation Yrotation", f"CHANNELS {len(order)} {channels}")
+    text = TWO_JOINT.replace(
+        "CHANNELS 3 Zrotation Xrotation Yrotation", f"CHANNELS {len(order)} {channels}"
+    )
     text = text.replace("1 2 3 90 0 0 0 0 0\n1 2 3 90 0 0 0 90 0\n", "")
-    text = text.replace("Frames: 2", "Frames: 1") + "0 0 0 0 0 0 " + " ".join(map(str, angles)) + "\n"
+    text = (
+        text.replace("Frames: 2", "Frames: 1") + "0 0 0 0 0 0 " + " ".join(map(str, angles)) + "\n"
+    )
     m = read_bvh(write_text(tmp_path, text), unit="m", up="z")
     rotation = np.eye(3)
     for axis, deg in zip(order, angles, strict=True):
@@ -142,7 +146,9 @@ def test_six_channel_joints_fold_the_static_root(tmp_path):
     m = read_bvh(write_text(tmp_path, BANDAI_LIKE), unit="cm")
     pos = positions_by_name(m)
     # Hips' position channels replace its OFFSET: (5,91,-40) cm, Z up (-0.40, 0.05, 0.91).
-    np.testing.assert_allclose(pos["Hips"][:, [1, 2, 0]] * 100, [[5, 91, -40], [6, 92, -30], [7, 93, -20]])
+    np.testing.assert_allclose(
+        pos["Hips"][:, [1, 2, 0]] * 100, [[5, 91, -40], [6, 92, -30], [7, 93, -20]]
+    )
     # Spine's constant channels (20, 1e-6, 0) are its offset, turned up by Hips' Rz(90).
     np.testing.assert_allclose(pos["Spine"] - pos["Hips"], [[0, 0, 0.2]] * 3, atol=1e-7)
     np.testing.assert_allclose(np.linalg.norm(pos["Spine"] - pos["Hips"], axis=1), 0.2, atol=1e-7)
@@ -151,7 +157,9 @@ def test_six_channel_joints_fold_the_static_root(tmp_path):
 
 
 def test_moving_position_channels_below_the_root_are_rejected(tmp_path):
-    text = BANDAI_LIKE.replace("20 0.000001 0 0 0 0\n0 0 0 0 0 0 6", "25 0.000001 0 0 0 0\n0 0 0 0 0 0 6")
+    text = BANDAI_LIKE.replace(
+        "20 0.000001 0 0 0 0\n0 0 0 0 0 0 6", "25 0.000001 0 0 0 0\n0 0 0 0 0 0 6"
+    )
     with pytest.raises(MotionFormatError, match="Spine.*moving position channels") as err:
         read_bvh(write_text(tmp_path, text), unit="cm")
     assert err.value.line == 10
@@ -167,10 +175,14 @@ def test_end_sites_are_site_joints(tmp_path):
     assert m.skeleton.parents.tolist() == [-1, 0, 1, 1]
 
 
-@pytest.mark.parametrize(("unit", "scale"), [("cm", 0.01), ("m", 1.0), ("inch", 0.0254), ("cmu", 0.056444), (0.5, 0.5)])
+@pytest.mark.parametrize(
+    ("unit", "scale"), [("cm", 0.01), ("m", 1.0), ("inch", 0.0254), ("cmu", 0.056444), (0.5, 0.5)]
+)
 def test_units_scale_positions(tmp_path, unit, scale):
     m = read_bvh(write_text(tmp_path, TWO_JOINT), unit=unit)
-    np.testing.assert_allclose(positions_by_name(m)["B_end"][1], np.array([13.0, -9.0, 2.0]) * scale)
+    np.testing.assert_allclose(
+        positions_by_name(m)["B_end"][1], np.array([13.0, -9.0, 2.0]) * scale
+    )
 
 
 def _upright_chain(height_units: float) -> str:
@@ -183,7 +195,9 @@ def _upright_chain(height_units: float) -> str:
     )
 
 
-@pytest.mark.parametrize(("height", "unit"), [(175.0, "cm"), (1.8, "m"), (30.0, "cmu"), (66.0, "inch")])
+@pytest.mark.parametrize(
+    ("height", "unit"), [(175.0, "cm"), (1.8, "m"), (30.0, "cmu"), (66.0, "inch")]
+)
 def test_unit_is_detected_from_standing_height(tmp_path, height, unit):
     assert read_bvh(write_text(tmp_path, _upright_chain(height))).meta["unit"] == unit
 
@@ -225,7 +239,12 @@ MALFORMED = [
     ("short frame line", TWO_JOINT.replace("0 0 0 90 0", "0 0 90 0"), 20, "8 values"),
     ("channel count", TWO_JOINT.replace("CHANNELS 3 Z", "CHANNELS 2 Z"), 9, "'Yrotation'"),
     ("bad channel name", TWO_JOINT.replace("Xrotation Y", "Wrotation Y"), 9, "bad channel list"),
-    ("unknown keyword", TWO_JOINT.replace("    End Site", "    Bone"), 10, "unknown keyword 'Bone'"),
+    (
+        "unknown keyword",
+        TWO_JOINT.replace("    End Site", "    Bone"),
+        10,
+        "unknown keyword 'Bone'",
+    ),
     ("nan value", TWO_JOINT.replace("0 0 0 90 0", "0 0 nan 90 0"), 20, "NaN"),
     ("inf value", TWO_JOINT.replace("0 0 0 90 0", "0 0 1e999 90 0"), 20, "NaN or infinite"),
     ("word value", TWO_JOINT.replace("0 0 0 90 0", "0 0 x 90 0"), 20, "'x' is not a number"),
@@ -238,7 +257,9 @@ MALFORMED = [
 ]
 
 
-@pytest.mark.parametrize(("text", "line", "message"), [m[1:] for m in MALFORMED], ids=[m[0] for m in MALFORMED])
+@pytest.mark.parametrize(
+    ("text", "line", "message"), [m[1:] for m in MALFORMED], ids=[m[0] for m in MALFORMED]
+)
 def test_malformed_files_name_file_and_line(tmp_path, text, line, message):
     path = write_text(tmp_path, text)
     with pytest.raises(MotionFormatError, match=message) as err:

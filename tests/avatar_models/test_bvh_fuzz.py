@@ -28,9 +28,44 @@ def _valid_files() -> list[bytes]:
 
 VALID = _valid_files()
 TOKENS = st.sampled_from(
-    ["{", "}", "ROOT", "JOINT", "End", "Site", "OFFSET", "CHANNELS", "MOTION", "Frames:", "Frame",
-     "Time:", "Xposition", "Zrotation", "6", "3", "0", "-1", "nan", "inf", "-inf", "1e999", "1e308",
-     "-1e308", "1e-320", "9" * 40, "0x1F", "1_0", "", "\n", "\t", "\r", "\x00", "é", "\u2028", "\x1c"]
+    [
+        "{",
+        "}",
+        "ROOT",
+        "JOINT",
+        "End",
+        "Site",
+        "OFFSET",
+        "CHANNELS",
+        "MOTION",
+        "Frames:",
+        "Frame",
+        "Time:",
+        "Xposition",
+        "Zrotation",
+        "6",
+        "3",
+        "0",
+        "-1",
+        "nan",
+        "inf",
+        "-inf",
+        "1e999",
+        "1e308",
+        "-1e308",
+        "1e-320",
+        "9" * 40,
+        "0x1F",
+        "1_0",
+        "",
+        "\n",
+        "\t",
+        "\r",
+        "\x00",
+        "é",
+        "\u2028",
+        "\x1c",
+    ]
 )
 
 
@@ -38,7 +73,9 @@ TOKENS = st.sampled_from(
 def mutated(draw) -> bytes:
     data = draw(st.sampled_from(VALID))
     for _ in range(draw(st.integers(1, 3))):
-        kind = draw(st.sampled_from(["truncate", "delete", "duplicate", "replace", "insert", "bytes"]))
+        kind = draw(
+            st.sampled_from(["truncate", "delete", "duplicate", "replace", "insert", "bytes"])
+        )
         words = data.split(b" ")
         k = draw(st.integers(0, max(0, len(words) - 1)))
         if kind == "truncate":

@@ -14,7 +14,9 @@ from tests.avatar_models.test_bvh import random_motion
 def test_round_trip_is_exact(tmp_path):
     motion = random_motion(np.random.default_rng(3), n_joints=6, n_frames=9)
     sk = motion.skeleton
-    limited = Skeleton(sk.names, sk.parents, sk.offsets, sk.is_site, {"j1": {"rx": (-0.5, 1.25)}}, "demo")
+    limited = Skeleton(
+        sk.names, sk.parents, sk.offsets, sk.is_site, {"j1": {"rx": (-0.5, 1.25)}}, "demo"
+    )
     motion = motion.replace(skeleton=limited, fps=90.0, meta={"seed": 3, "activity": "walk"})
     path = write_npz(motion, tmp_path / "m.npz")
     back = read_npz(path)

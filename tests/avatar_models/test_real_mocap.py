@@ -111,7 +111,9 @@ def test_positions_agree_with_bvhio(mocap_dir, clips, clip):
         np.testing.assert_allclose(got, expected, atol=1e-5, err_msg=f"{clip} {name}")
 
 
-@pytest.mark.parametrize("clip", ["cmu/16_35.bvh", "bandai/dataset-2/data/dataset-2_run_normal_003.bvh"])
+@pytest.mark.parametrize(
+    "clip", ["cmu/16_35.bvh", "bandai/dataset-2/data/dataset-2_run_normal_003.bvh"]
+)
 def test_real_clip_write_read_round_trip(tmp_path, clips, clip):
     motion = clips[clip]
     unit = motion.meta["unit"]

@@ -1,0 +1,89 @@
+"""BVH parsing and forward kinematics, next to bvhio (a PyPI BVH library) in the same process.
+
+Rows: BVH parse throughput in MB/s (our ``read_bvh``, which also builds the ``Motion``, vs
+``bvhio.readAsBvh``) and forward kinematics in (frames x joints)/s (``Motion.global_positions``
+vs bvhio's ``loadPose`` + ``PositionWorld`` per frame). Files: a CMU and a Bandai clip from
+``../shared/mocap``; a generated clip when that folder is absent.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from avatar_models.formats.bvh import read_bvh, write_bvh
+from scripts.benchmarks import BenchRow, best_of
+
+MOCAP_DIR = Path(__file__).resolve().parents[2].parent / "shared" / "mocap"
+REAL_CLIPS = ("cmu/125_01.bvh", "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh")
+
+
+def _generated_clip(folder: Path) -> Path:
+    from tests.avatar_models.test_bvh import random_motion  # test helper, benchmark-only use
+
+    motion = random_motion(np.random.default_rng(0), n_joints=31, n_frames=600)
+    return write_bvh(
+        motion.translated(np.array([0.0, 0.0, 1.0])), folder / "generated.bvh", unit="cm"
+    )
+
+
+def _bvhio_fk(path: Path, frames: int) -> None:
+    import bvhio
+
+    root = bvhio.readAsHierarchy(str(path))
+    joints = [j for j, _, _ in root.layout()]
+    for frame in range(frames):
+        root.loadPose(frame)
+        for joint in joints:
+            _ = joint.PositionWorld
+
+
+def _rows_for(path: Path, label: str, quick: bool) -> list[BenchRow]:
+    import bvhio
+
+    megabytes = path.stat().st_size / 1e6
+    unit = "cmu" if "cmu" in label else "cm"
+    repeat = 2 if quick else 5
+    ours = best_of(lambda: read_bvh(path, unit=unit), repeat)
+    theirs = best_of(lambda: bvhio.readAsBvh(str(path)), 1 if quick else 2)
+    rows = [
+        BenchRow(
+            f"bvh_parse[{label}]",
+            "MB/s",
+            megabytes / ours,
+            megabytes / theirs,
+            "bvhio.readAsBvh",
+            f"{megabytes:.2f} MB",
+        )
+    ]
+    motion = read_bvh(path, unit=unit)
+    n_joints = sum(1 for s in motion.skeleton.is_site if not s)  # bvhio has no end-site joints
+    fk_ours = best_of(lambda: motion.replace().global_positions(), repeat)
+    frames = min(motion.n_frames, 30 if quick else 120)
+    fk_theirs = best_of(lambda: _bvhio_fk(path, frames), 1)
+    load_only = best_of(lambda: _bvhio_fk(path, 0), 1)  # hierarchy construction, not FK
+    rows.append(
+        BenchRow(
+            f"fk[{label}]",
+            "frames*joints/s",
+            motion.n_frames * motion.skeleton.n_joints / fk_ours,
+            frames * n_joints / max(fk_theirs - load_only, 1e-9),
+            "bvhio loadPose+PositionWorld",
+            f"{motion.n_frames} frames x {motion.skeleton.n_joints} joints",
+        )
+    )
+    return rows
+
+
+def run(quick: bool = False) -> list[BenchRow]:
+    """Parse and FK rows per clip; see the module docstring."""
+    if MOCAP_DIR.is_dir():
+        return [
+            row
+            for clip in REAL_CLIPS
+            for row in _rows_for(MOCAP_DIR / clip, clip.split("/")[0], quick)
+        ]
+    with tempfile.TemporaryDirectory() as tmp:
+        return _rows_for(_generated_clip(Path(tmp)), "generated", quick)
