@@ -19,7 +19,8 @@ def body17_motion(fps: float = 90.0, seconds: float = 2.0) -> Motion:
     skeleton = load_rig("body17").skeleton
     t = np.arange(int(round(seconds * fps)) + 1) / fps
     n, j = t.size, skeleton.n_joints
-    phase = np.arange(j)[None, :] * 0.7 + 2.0 * np.pi * (0.5 + 0.1 * np.arange(j))[None, :] * t[:, None]
+    freq = 0.5 + 0.1 * np.arange(j)
+    phase = 0.7 * np.arange(j)[None, :] + 2.0 * np.pi * freq[None, :] * t[:, None]
     axes = np.stack([np.sin(np.arange(j)), np.cos(np.arange(j)), np.ones(j)], axis=1)
     rotvec = 0.4 * np.sin(phase)[..., None] * axes / np.linalg.norm(axes, axis=1)[:, None]
     local = quat.from_scipy(Rotation.from_rotvec(rotvec.reshape(-1, 3)), (n, j))
