@@ -26,7 +26,7 @@ from avatar_models.rigs import identify_rig
 from render_cams.device import DeviceError
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # array fields: compare with as_dict(), not ==
 class Attachment:
     """A device rigidly fixed to a joint.
 
@@ -82,7 +82,8 @@ class OffsetSpread:
                 raise DeviceError(f"OffsetSpread.{name} must be >= 0, got {value!r}")
 
     def perturb(self, attachment: Attachment, rng: np.random.Generator) -> Attachment:
-        """``attachment`` with a random offset added in the device's own frame."""
+        """``attachment`` moved by a random offset (position in the joint frame) and turned by a
+        random rotation (in the device's own frame)."""
         dp = rng.normal(0.0, self.position_sigma_m, 3)
         dr = quat.from_scipy(Rotation.from_rotvec(rng.normal(0.0, self.rotation_sigma_rad, 3)))
         return Attachment(
