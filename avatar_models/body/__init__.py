@@ -1,0 +1,17 @@
+"""The body: one description of a humanoid that yields the MuJoCo model and the render mesh.
+
+``build_body(skeleton)`` turns any skeleton :func:`avatar_models.rigs.identify_rig` recognises
+into a :class:`BodyDescription`: capsules per bone with de Leva (1996) masses, box or capsule
+feet, a skull sphere, anatomical hinge ranges. From it, ``to_mjcf()`` gives an MJCF string
+(free root, three hinges and position actuators per simulated joint, floor, contacts, body17
+sites), ``qpos_from_motion(motion)`` the exact MuJoCo ``qpos`` of a motion on that skeleton,
+and ``to_trimesh(...)`` the same primitives posed for one frame. MuJoCo is imported only in
+:mod:`avatar_models.body.mjcf`.
+"""
+
+from avatar_models.body.description import BodyDescription, build_body
+from avatar_models.body.errors import BodyError
+from avatar_models.body.geometry import Segment
+from avatar_models.body.mjcf import hinge_name
+
+__all__ = ["BodyDescription", "BodyError", "Segment", "build_body", "hinge_name"]

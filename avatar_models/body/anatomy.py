@@ -1,0 +1,133 @@
+"""Which skeleton joints are simulated, what anatomical role each has, and what each bone is.
+
+Works for any skeleton :func:`avatar_models.rigs.identify_rig` recognises, from its ``body17``
+map alone. The simulated joints are the chains from the root to the head, the wrists and the
+ankles; every other joint (fingers, toes, jaw, eyelids, twist bones, end sites) is fixed into
+its nearest simulated ancestor. A joint's role names the anatomical joint it stands for
+(see :mod:`avatar_models.body.joint_ranges`), a bone's kind names the de Leva segment it
+belongs to (see :mod:`avatar_models.body.anthropometry`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from avatar_models.rigs import Rig
+from avatar_models.skeleton import Skeleton
+
+# Along a limb chain, body17 joint -> role from that joint down to the next body17 joint.
+_LIMB_ROLES = {
+    "leg": (("hip", "hip"), ("knee", "knee"), ("ankle", "ankle")),
+    "arm": (("shoulder", "shoulder"), ("elbow", "elbow"), ("wrist", "wrist")),
+}
+_GIRDLE = {"leg": "pelvic_girdle", "arm": "shoulder_girdle"}
+_END = {"leg": "ankle", "arm": "wrist"}
+
+# Role of a bone's proximal joint -> the segment kind of the bone.
+_BONE_KIND = {
+    "root_chain": "pelvis",
+    "pelvic_girdle": "pelvis",
+    "spine": "torso",
+    "shoulder_girdle": "torso",
+    "hip": "thigh",
+    "knee": "shank",
+    "ankle": "foot",
+    "shoulder": "upper_arm",
+    "elbow": "forearm",
+    "wrist": "hand",
+}
+
+
+@dataclass(frozen=True)
+class Anatomy:
+    """Joint classification of one skeleton.
+
+    Attributes:
+        simulated: ``(J,)`` bool, joints that get a MuJoCo body.
+        roles: role of each simulated non-root joint (index -> role), the root has ``"root"``.
+        sides: ``"left"``, ``"right"`` or ``"center"`` per joint.
+        chain_lengths: per simulated joint, how many joints share its role on its chain.
+        bone_kind: ``(J,)`` segment kind of the bone from each joint's parent to it
+            (``""`` for the root).
+        body_of: ``(J,)`` index of the simulated joint whose body carries each joint.
+        body17: body17 name -> joint index.
+    """
+
+    simulated: np.ndarray
+    roles: dict[int, str]
+    sides: tuple[str, ...]
+    chain_lengths: dict[int, int]
+    bone_kind: tuple[str, ...]
+    body_of: np.ndarray
+    body17: dict[str, int]
+
+
+def classify(skeleton: Skeleton, rig: Rig) -> Anatomy:
+    """Classify the joints of ``skeleton`` using the ``body17`` map of ``rig``."""
+    b = {k: skeleton.index(v) for k, v in rig.body17.items()}
+    trunk = skeleton.chain(b["neck"])
+    pelvis_chain = set(skeleton.chain(b["pelvis"]))
+    head_chain = skeleton.chain(b["head"])
+    limb_chains = {
+        (side, limb): skeleton.chain(b[f"{side[0]}_{_END[limb]}"])
+        for side in ("left", "right")
+        for limb in ("leg", "arm")
+    }
+    roles: dict[int, str] = {0: "root"}
+    sides = ["center"] * skeleton.n_joints
+    for j in trunk + head_chain:
+        if j == 0:
+            continue
+        if j in pelvis_chain:
+            roles[j] = "root_chain"
+        elif j in trunk and j != b["neck"]:
+            roles[j] = "spine"
+        else:
+            roles[j] = "cervical"
+    arm_path: set[int] = set()
+    for (side, limb), chain in limb_chains.items():
+        role = _GIRDLE[limb]
+        marks = {b[f"{side[0]}_{name}"]: r for name, r in _LIMB_ROLES[limb]}
+        for j in chain:
+            if j in roles and j not in marks:
+                continue
+            role = marks.get(j, role)
+            roles[j] = role
+            sides[j] = side
+            if limb == "arm":
+                arm_path.add(j)
+    simulated = np.zeros(skeleton.n_joints, bool)
+    simulated[list(roles)] = True
+
+    chain_lengths = {
+        j: sum(roles.get(k) == roles[j] for k in skeleton.chain(j) + _descendants(skeleton, j))
+        for j in roles
+    }
+    bone_kind = [""] * skeleton.n_joints
+    body_of = np.arange(skeleton.n_joints)
+    for c in range(1, skeleton.n_joints):
+        p = int(skeleton.parents[c])
+        if not simulated[c]:
+            body_of[c] = body_of[p]
+            sides[c] = sides[p]
+        if not simulated[p]:
+            bone_kind[c] = bone_kind[p]
+        elif roles[p] == "cervical":
+            bone_kind[c] = "torso" if c in arm_path else "head"
+        elif roles[p] in ("root", "root_chain") and c in trunk:
+            bone_kind[c] = "torso"
+        else:
+            bone_kind[c] = _BONE_KIND.get(roles[p], "pelvis")
+    return Anatomy(simulated, roles, tuple(sides), chain_lengths, tuple(bone_kind), body_of, b)
+
+
+def _descendants(skeleton: Skeleton, j: int) -> list[int]:
+    """All joints below ``j`` (parents come before children, so one pass suffices)."""
+    below = np.zeros(skeleton.n_joints, bool)
+    below[j] = True
+    for c in range(j + 1, skeleton.n_joints):
+        below[c] = below[skeleton.parents[c]]
+    below[j] = False
+    return list(np.flatnonzero(below))
