@@ -12,11 +12,14 @@ upwards, so they use 1 - 0.4486. The head is a sphere and its mass sits at its c
 
 Radii are ``circumference / (2 pi)`` of ANSUR II male means (Gordon et al. 2014, *2012
 Anthropometric Survey of U.S. Army Personnel*, stature 1756 mm), divided by that stature so
-they scale with the body: thigh 616 mm, calf 391 mm, biceps (flexed) 358 mm, forearm (flexed)
-299 mm, wrist 175 mm, neck 398 mm, head 573 mm. A circle of the chest circumference would be
-a third deeper than a real chest, so the trunk capsules use half the chest depth (255 mm) and
-the pelvis half the buttock depth (250 mm). Feet are boxes of ANSUR II foot length (270 mm)
-and foot breadth (101 mm).
+they scale with the body. A capsule has one radius for a tapering limb, so it takes the mean
+of the proximal and distal girths: thigh (616 mm) and lower thigh (407 mm), calf (391 mm) and
+ankle (225 mm), forearm (flexed, 299 mm) and wrist (175 mm); the upper arm uses the biceps
+(flexed, 358 mm), the hand the wrist, the neck its own girth (398 mm), the skull the head
+circumference (573 mm). A circle of the chest circumference would be a third deeper than a
+real chest, so the trunk capsules use half the chest depth (255 mm) and the pelvis half the
+buttock depth (250 mm). Feet are boxes of ANSUR II foot length (270 mm) and foot breadth
+(101 mm).
 """
 
 from __future__ import annotations
@@ -27,9 +30,9 @@ from dataclasses import dataclass
 ANSUR_STATURE_M = 1.756
 
 
-def _radius_from_circumference(circumference_m: float) -> float:
-    """Radius / stature of a circle with the given ANSUR II circumference."""
-    return circumference_m / math.tau / ANSUR_STATURE_M
+def _radius_from_circumference(*circumferences_m: float) -> float:
+    """Radius / stature of a circle with the mean of the given ANSUR II circumferences."""
+    return sum(circumferences_m) / len(circumferences_m) / math.tau / ANSUR_STATURE_M
 
 
 @dataclass(frozen=True)
@@ -46,10 +49,10 @@ SEGMENTS: dict[str, SegmentParameters] = {
     "torso": SegmentParameters(0.1633 + 0.1596, 1.0 - 0.4486, 0.1275 / ANSUR_STATURE_M),
     "head": SegmentParameters(0.0694, 0.5, _radius_from_circumference(0.398)),
     "upper_arm": SegmentParameters(0.0271, 0.5772, _radius_from_circumference(0.358)),
-    "forearm": SegmentParameters(0.0162, 0.4574, _radius_from_circumference(0.299)),
+    "forearm": SegmentParameters(0.0162, 0.4574, _radius_from_circumference(0.299, 0.175)),
     "hand": SegmentParameters(0.0061, 0.7900, _radius_from_circumference(0.175)),
-    "thigh": SegmentParameters(0.1416, 0.4095, _radius_from_circumference(0.616)),
-    "shank": SegmentParameters(0.0433, 0.4459, _radius_from_circumference(0.391)),
+    "thigh": SegmentParameters(0.1416, 0.4095, _radius_from_circumference(0.616, 0.407)),
+    "shank": SegmentParameters(0.0433, 0.4459, _radius_from_circumference(0.391, 0.225)),
     "foot": SegmentParameters(0.0137, 0.4415, 0.101 / 2 / ANSUR_STATURE_M),
 }
 """Per segment kind. ``head`` radius is the neck's (the skull is :data:`HEAD_RADIUS_RATIO`);

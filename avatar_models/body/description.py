@@ -29,6 +29,10 @@ from avatar_models.skeleton import Skeleton
 
 MAX_HEIGHT_M = 3.0
 FOOT_SHAPES = ("box", "capsule")
+CAPS_INSIDE = {"upper_arm": (True, False), "shank": (False, True)}
+"""Segment kind -> (proximal, distal) caps that end at the joint rather than around it: the
+upper arm does not start inside the chest (where it would touch the trunk in the rest pose
+and have to be excluded from collisions with it), the shin never reaches below the foot."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -314,8 +318,8 @@ class _Layout:
 
     def _capsules(self) -> list[Segment]:
         """A capsule per bone between two simulated joints (zero-length bones have none),
-        its CoM at de Leva's fraction from the proximal joint. The shank's distal cap ends
-        at the ankle, so the shin never reaches below the foot."""
+        its CoM at de Leva's fraction from the proximal joint. Some caps end at their joint
+        instead of around it (:data:`CAPS_INSIDE`)."""
         out = []
         for c in np.flatnonzero(self.an.simulated)[1:]:
             kind, side, bone = self.an.bone_kind[c], self.an.sides[c], self.sk.offsets[c]
@@ -323,7 +327,8 @@ class _Layout:
             if length < 1e-9:
                 continue
             r = self.radius(kind, side)
-            end = bone * (1.0 - min(r / length, 0.5)) if kind == "shank" else bone
+            inset = min(r / length, 0.5) * bone
+            proximal, distal = CAPS_INSIDE.get(kind, (False, False))
             out.append(
                 Segment(
                     name=f"{kind}:{self.sk.names[c]}",
@@ -331,8 +336,8 @@ class _Layout:
                     side=side,
                     body=int(self.sk.parents[c]),
                     shape="capsule",
-                    start=np.zeros(3),
-                    end=end,
+                    start=inset if proximal else np.zeros(3),
+                    end=bone - inset if distal else bone,
                     radius=r,
                     mass=0.0,
                     com=anthro.SEGMENTS[kind].com * bone,

@@ -1,0 +1,175 @@
+"""The MuJoCo model of the body: loads, stands, replays motions exactly."""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from avatar_models import quat
+from avatar_models.body import BodyDescription, BodyError, build_body, hinge_name
+from avatar_models.body17 import BODY17
+from avatar_models.motion import Motion
+from avatar_models.rigs import load_rig
+
+RIGS = ("body17", "avatar", "cmu")
+
+
+def _model(body: BodyDescription) -> tuple[mujoco.MjModel, mujoco.MjData]:
+    model = mujoco.MjModel.from_xml_string(body.to_mjcf())
+    return model, mujoco.MjData(model)
+
+
+def _random_motion(rig: str, frames: int, seed: int, max_angle: float) -> Motion:
+    """Random local rotations up to ``max_angle`` radians about random axes."""
+    sk = load_rig(rig).skeleton
+    rng = np.random.default_rng(seed)
+    axes = rng.normal(size=(frames, sk.n_joints, 3))
+    angles = rng.uniform(-max_angle, max_angle, size=(frames, sk.n_joints))
+    root = rng.normal(size=(frames, 3)) + [0.0, 0.0, 1.0]
+    return Motion(sk, 30.0, root, quat.from_axis_angle(axes, angles))
+
+
+@pytest.mark.parametrize("rig", RIGS)
+def test_model_loads_with_limited_actuated_hinges(rig):
+    body = build_body(load_rig(rig).skeleton)
+    model, _ = _model(body)
+    n_hinged = len(body.simulated_joints) - 1
+    assert model.nq == 7 + 3 * n_hinged
+    assert model.nu == 3 * n_hinged
+    hinges = model.jnt_type == mujoco.mjtJoint.mjJNT_HINGE
+    assert hinges.sum() == 3 * n_hinged and model.jnt_limited[hinges].all()
+    assert model.body_subtreemass[1] == pytest.approx(75.0, rel=0.01)
+    for name in BODY17:
+        model.site(name)  # raises KeyError if absent
+    for segment in body.segments:
+        assert model.geom(segment.name).bodyid == model.body(body.skeleton.names[segment.body]).id
+    assert model.ngeom == len(body.segments) + 1  # + floor
+
+
+def test_actuator_gains_scale_with_body_mass():
+    sk = load_rig("avatar").skeleton
+    light, _ = _model(build_body(sk, mass_kg=60.0))
+    heavy, _ = _model(build_body(sk, mass_kg=90.0))
+    for joint in ("Bip01 L Foot", "Bip01 L Forearm", "Bip01 Neck"):
+        name = hinge_name(joint, "y")
+        ratio = heavy.actuator(name).gainprm[0] / light.actuator(name).gainprm[0]
+        assert ratio == pytest.approx(1.5, rel=1e-6)
+    # Legs carry the whole body, so the ankle is stiffer than the much lighter wrist.
+    assert (
+        light.actuator(hinge_name("Bip01 L Foot", "y")).gainprm[0]
+        > 50 * light.actuator(hinge_name("Bip01 L Hand", "y")).gainprm[0]
+    )
+
+
+@pytest.mark.parametrize("rig", RIGS)
+@pytest.mark.parametrize("foot", ["box", "capsule"])
+def test_rest_pose_soles_touch_the_floor(rig, foot):
+    body = build_body(load_rig(rig).skeleton, foot=foot)
+    model, data = _model(body)
+    mujoco.mj_forward(model, data)
+    lowest = []
+    for segment in body.segments:
+        if segment.kind != "foot":
+            continue
+        g = model.geom(segment.name)
+        pos, rot = data.geom_xpos[g.id], data.geom_xmat[g.id].reshape(3, 3)
+        if foot == "box":
+            corners = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).reshape(3, -1).T
+            lowest.append((pos + (corners * g.size) @ rot.T)[:, 2].min())
+        else:  # capsule along its local z, half length size[1]
+            ends = pos + np.outer([-1, 1], rot[:, 2] * g.size[1])
+            lowest.append(ends[:, 2].min() - g.size[0])
+    assert min(lowest) == pytest.approx(0.0, abs=0.002)
+
+
+@pytest.mark.parametrize(
+    ("rig", "foot"), [("body17", "box"), ("avatar", "box"), ("avatar", "capsule")]
+)
+def test_standing_pose_is_held_for_two_seconds(rig, foot):
+    body = build_body(load_rig(rig).skeleton, foot=foot)
+    model, data = _model(body)
+    root = model.body(body.skeleton.names[0]).id
+    floor = model.geom("floor").id
+    start_height = body.root_height
+    deepest, lowest_root, least_upright = 0.0, np.inf, 1.0
+    for _ in range(int(2.0 / model.opt.timestep)):
+        data.ctrl[:] = 0.0  # the rest pose
+        mujoco.mj_step(model, data)
+        lowest_root = min(lowest_root, data.xpos[root, 2])
+        least_upright = min(least_upright, data.xmat[root].reshape(3, 3)[2, 2])
+        for c in data.contact[: data.ncon]:
+            if floor in (c.geom1, c.geom2):
+                deepest = max(deepest, -c.dist)
+    assert np.isfinite(data.qpos).all()
+    assert least_upright > np.cos(np.radians(5.0))
+    assert lowest_root > 0.97 * start_height
+    assert deepest < 0.01
+
+
+@pytest.mark.parametrize("rig", RIGS)
+@pytest.mark.parametrize("max_angle", [0.6, np.pi])
+def test_qpos_reproduces_global_positions(rig, max_angle):
+    motion = _random_motion(rig, frames=20, seed=7, max_angle=max_angle)
+    body = build_body(motion.skeleton)
+    model, data = _model(body)
+    qpos = body.qpos_from_motion(motion)
+    assert qpos.shape == (motion.n_frames, model.nq)
+    expected = motion.global_positions()
+    body_ids = [model.body(motion.skeleton.names[j]).id for j in body.simulated_joints]
+    body17 = load_rig(body.rig.name).body17_indices(motion.skeleton)
+    site_ids = [model.site(name).id for name in BODY17]
+    for t in range(motion.n_frames):
+        data.qpos[:] = qpos[t]
+        mujoco.mj_kinematics(model, data)
+        np.testing.assert_allclose(
+            data.xpos[body_ids], expected[t, body.simulated_joints], atol=1e-6
+        )
+        np.testing.assert_allclose(data.site_xpos[site_ids], expected[t, body17], atol=1e-6)
+
+
+def test_qpos_hinge_angles_are_continuous_through_a_full_turn():
+    sk = load_rig("avatar").skeleton
+    turn = np.linspace(0.0, 4 * np.pi, 241)  # two turns of the first hinge of the left hip
+    rot = np.tile(quat.IDENTITY, (turn.size, sk.n_joints, 1))
+    hip = sk.index("Bip01 L Thigh")
+    rot[:, hip] = quat.from_scipy(
+        Rotation.from_euler("YXZ", np.c_[turn, 0.2 + 0 * turn, 0.1 + 0 * turn])
+    )
+    motion = Motion(sk, 60.0, np.tile([0.0, 0.0, 1.0], (turn.size, 1)), rot)
+    body = build_body(sk)
+    qpos = body.qpos_from_motion(motion)
+    column = 7 + body.hinges.index((hip, "y"))
+    np.testing.assert_allclose(qpos[:, column], turn, atol=1e-9)
+
+
+def test_qpos_rejects_a_motion_on_another_skeleton():
+    body = build_body(load_rig("avatar").skeleton)
+    with pytest.raises(BodyError, match="skeleton"):
+        body.qpos_from_motion(_random_motion("body17", 2, 0, 0.1))
+
+
+def test_non_adjacent_segments_collide_adjacent_do_not():
+    body = build_body(load_rig("body17").skeleton)
+    model, data = _model(body)
+    # Both arms swung 110 degrees forward horizontally: the forearms cross in front.
+    qpos = model.qpos0.copy()
+    for joint, sign in (("l_shoulder", -1.0), ("r_shoulder", 1.0)):
+        qpos[model.joint(hinge_name(joint, "z")).qposadr[0]] = sign * np.radians(110.0)
+    data.qpos[:] = qpos
+    mujoco.mj_forward(model, data)
+    touching = {
+        frozenset((model.geom_bodyid[c.geom1], model.geom_bodyid[c.geom2]))
+        for c in data.contact[: data.ncon]
+    }
+    left = {model.body(n).id for n in ("l_elbow", "l_wrist")}
+    right = {model.body(n).id for n in ("r_elbow", "r_wrist")}
+    assert any(len(pair & left) == 1 and len(pair & right) == 1 for pair in touching)
+    excluded = {
+        frozenset((a, b))
+        for a, b in zip(
+            model.exclude_signature >> 16, model.exclude_signature & 0xFFFF, strict=True
+        )
+    }
+    assert frozenset((model.body("l_hip").id, model.body("l_knee").id)) in excluded
