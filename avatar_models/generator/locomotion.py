@@ -1,0 +1,153 @@
+"""Cyclic locomotion: walk, run, and walking while dribbling a ball with the right hand.
+
+Feet follow :func:`~avatar_models.generator.feet.gait_track`; the pelvis travels at constant
+speed with lateral sway, rotation and list, and its height is the lower of a bobbing curve and
+what the legs can reach; the trunk counter-rotates, arms swing opposite the legs.
+Cadence and stride defaults: walking about 0.95 strides/s with a stride of 0.78 stature
+(about 1.35 m/s for 1.75 m; Grieve & Gear 1966, Perry & Burnfield ch. 1); running about
+1.4 strides/s with 1.3 statures per stride (about 3.2 m/s; Novacheck 1998, Gait & Posture 7).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from avatar_models.generator.feet import gait_track, pelvis_height_limit
+from avatar_models.generator.ik import euler
+from avatar_models.generator.plan import LimbTarget, Plan, Scene
+from avatar_models.generator.poses import arm_angles, gaze, heading_rotation, trunk
+
+TAU = 2.0 * np.pi
+
+
+@dataclass(frozen=True)
+class Gait:
+    """Parameters of a gait at tempo and amplitude 1 (angles in degrees, lengths in statures)."""
+
+    cadence: float  # strides per second
+    stride: float  # stride length / stature
+    speed_range: tuple[float, float]  # m/s, clamps what tempo and amplitude produce
+    duty: float  # stance fraction
+    heel_rocker: float
+    toe_off: float
+    clearance: float  # ankle lift at mid-swing / stature
+    bob: float  # pelvis vertical oscillation / stature
+    crouch: float  # pelvis lowered / leg length
+    running: bool  # pelvis lowest at mid-stance (spring-mass) instead of highest (vaulting)
+    pelvis_yaw: float
+    arm_swing: float
+    elbow: float
+    lean: float
+
+
+WALK = Gait(0.95, 0.78, (0.85, 1.7), 0.62, 12, 30, 0.055, 0.012, 0.03, False, 5, 18, 15, 2)
+RUN = Gait(1.4, 1.3, (2.2, 4.5), 0.38, 4, 35, 0.11, 0.03, 0.08, True, 8, 30, 85, 8)
+DRIBBLE = Gait(0.85, 0.55, (0.6, 1.1), 0.64, 10, 25, 0.05, 0.01, 0.08, False, 4, 10, 40, 12)
+
+
+def _gait_plan(scene: Scene, gait: Gait) -> tuple[Plan, np.ndarray]:
+    """The plan of a straight gait along +X and the left foot's phase ``(T,)``."""
+    style, n, t = scene.style, scene.n_frames, scene.times
+    height = scene.subject.height_m
+    frequency = gait.cadence * style.tempo
+    speed = np.clip(gait.stride * height * np.sqrt(style.amplitude) * frequency, *gait.speed_range)
+    stride = speed / frequency
+    swing_amp = np.radians(gait.arm_swing) * style.amplitude
+    tracks = []
+    for side, offset in (("L", 0.0), ("R", 0.5)):
+        ankle_rest = scene.rest(f"Bip01 {side} Foot")
+
+        def plant_at(
+            k: np.ndarray, off: float = offset, rest: np.ndarray = ankle_rest
+        ) -> np.ndarray:
+            x = stride * (k + gait.duty / 2 - off) - 0.04 * height
+            return np.stack([x, np.full(k.shape, 0.85 * rest[1]), np.full(k.shape, rest[2])], 1)
+
+        tracks.append(
+            gait_track(
+                scene,
+                frequency,
+                gait.duty,
+                offset,
+                plant_at,
+                np.radians(gait.heel_rocker),
+                np.radians(gait.toe_off),
+                gait.clearance * height * style.amplitude,
+            )
+        )
+    phase_l = (t * frequency) % 1.0
+    mid_stance = TAU * (phase_l - gait.duty / 2)
+    yaw = -np.radians(gait.pelvis_yaw) * style.amplitude * np.cos(TAU * phase_l)
+    pelvis = euler(
+        np.stack(
+            [np.radians(3.0) * np.cos(mid_stance), np.full(n, np.radians(gait.lean / 2)), yaw], 1
+        )
+    )
+    root_rot = heading_rotation(0.0, n)
+    root_xy = np.stack([speed * t, 0.02 * height * np.cos(mid_stance) * (1 - gait.running)], 1)
+    rest_z = scene.skeleton.offsets[0, 2]
+    bob = gait.bob * height * style.amplitude * np.cos(2 * mid_stance)
+    nominal = (
+        rest_z
+        - (gait.crouch + style.knee_bend) * scene.leg_length
+        + np.where(gait.running, -bob, bob)
+    )
+    ankles = np.stack([tr.ankle for tr in tracks], axis=1)
+    limit = pelvis_height_limit(scene, root_xy, root_rot @ pelvis, ankles)
+    root_pos = np.column_stack([root_xy, np.minimum(nominal, limit)])
+
+    joints = {}
+    for side, tr in zip("LR", tracks, strict=True):
+        sign = 1.0 if side == "L" else -1.0
+        swing = -sign * swing_amp * np.cos(TAU * phase_l)
+        elbow = np.radians(gait.elbow) + 0.5 * swing_amp * np.clip(swing / swing_amp, 0, 1)
+        joints.update(arm_angles(scene, side, swing, np.radians(8.0), elbow))
+        joints[f"Bip01 {side} Toe0"] = tr.toe  # about Y: the same on both sides
+    pole = np.array([1.0, 0.0, 0.0])
+    legs = {
+        side: LimbTarget(tr.ankle, np.broadcast_to(pole + [0, 0.1 * sg, 0], (n, 3)), tr.rotation)
+        for side, tr, sg in (("L", tracks[0], 1), ("R", tracks[1], -1))
+    }
+    plan = Plan(
+        root_pos=root_pos,
+        root_rot=root_rot,
+        pelvis=pelvis,
+        spine=trunk(scene, np.radians(gait.lean / 2), 1.5 * -yaw),
+        head=gaze(scene, 0.0, np.radians(5.0)),
+        contacts=np.stack([tr.contact for tr in tracks], axis=1),
+        joints=joints,
+        legs=legs,
+        fist=np.full((n, 2), 0.5 if gait.running else 0.2),
+    )
+    return plan, phase_l
+
+
+def walk(scene: Scene) -> Plan:
+    return _gait_plan(scene, WALK)[0]
+
+
+def run(scene: Scene) -> Plan:
+    return _gait_plan(scene, RUN)[0]
+
+
+def dribble(scene: Scene) -> Plan:
+    """Walking slowly while bouncing a ball with the right hand twice per stride, eyes on it."""
+    plan, phase_l = _gait_plan(scene, DRIBBLE)
+    n, height = scene.n_frames, scene.subject.height_m
+    # Hand pushes down quickly and rides the ball up slowly: a skewed cosine over each bounce.
+    bounce = (2.0 * phase_l) % 1.0
+    down = np.where(bounce < 0.35, bounce / 0.35, 1.0 - (bounce - 0.35) / 0.65)
+    low, high = 0.43 * height, 0.55 * height
+    hand = np.column_stack(
+        [plan.root_pos[:, 0] + 0.2 * height, np.full(n, -0.17 * height), high - (high - low) * down]
+    )
+    # Fingers forward, palm down (yaw first), then the wrist flexes with the push.
+    wrist = euler(
+        np.column_stack([np.full(n, np.pi / 2), np.radians(-10 + 40 * down), np.zeros(n)]), "zyx"
+    )
+    plan.arms["R"] = LimbTarget(hand, np.broadcast_to([-1.0, -0.6, -0.3], (n, 3)), wrist)
+    plan.head = gaze(scene, -0.2, np.radians(25.0))
+    plan.fist[:, 1] = 0.1
+    return plan
