@@ -49,6 +49,7 @@ class BodyDescription:
         stature: sole to top of the skull in the rest pose (metres).
         segments: every primitive with its mass, in body frames.
         root_height: height of the root joint above the floor when standing in the rest pose.
+        source_skeleton: the skeleton given to :func:`build_body`, before any scaling.
     """
 
     skeleton: Skeleton
@@ -60,7 +61,7 @@ class BodyDescription:
     stature: float
     segments: tuple[Segment, ...]
     root_height: float
-    source_skeleton: Skeleton = field(repr=False, default=None)  # type: ignore[assignment]
+    source_skeleton: Skeleton = field(repr=False)
 
     # -- structure ------------------------------------------------------------------------
     @property
@@ -158,14 +159,14 @@ class BodyDescription:
         mass_kg: float | None = None,
     ) -> BodyDescription:
         """A new body from the original skeleton with per-segment length factors (e.g.
-        ``{"thigh": 1.05}``), then scaled uniformly to ``height_m``; the mass is kept unless
-        ``mass_kg`` is given."""
+        ``{"thigh": 1.05}``), then scaled uniformly to ``height_m``. Segment factors and
+        mass are kept unless given; ``height_m=None`` keeps the skeleton's own size."""
         return build_body(
             self.source_skeleton,
             height_m=height_m,
             mass_kg=self.mass_kg if mass_kg is None else mass_kg,
             foot=self.foot,
-            segment_scale=segment_scale,
+            segment_scale=self.segment_scale if segment_scale is None else segment_scale,
         )
 
 
@@ -208,6 +209,7 @@ def build_body(
     except RigError as exc:
         raise BodyError(f"cannot build a body: {exc}") from exc
     anatomy = classify(skeleton, rig)
+    _check_upright(skeleton, anatomy)
 
     kind_factor = np.array([scale.get(k, 1.0) for k in anatomy.bone_kind])
     sized = skeleton.with_offsets(skeleton.offsets * kind_factor[:, None])
@@ -228,6 +230,29 @@ def build_body(
         root_height=-lowest,
         source_skeleton=skeleton,
     )
+
+
+UPRIGHT_RATIO = 0.8
+
+
+def _check_upright(skeleton: Skeleton, anatomy: Anatomy) -> None:
+    """Raise unless the rest pose stands: the head must rise above each ankle by at least
+    :data:`UPRIGHT_RATIO` of the bone path between them. Feet, skull and joint ranges are
+    laid out in the rest frame, which is meaningless for rigs whose rest pose is not a
+    standing pose (e.g. BVH files whose joint orientations are baked into the offsets)."""
+    rest = skeleton.rest_positions()
+    lengths = skeleton.bone_lengths
+    head = anatomy.body17["head"]
+    for side in ("l", "r"):
+        ankle = anatomy.body17[f"{side}_ankle"]
+        path = set(skeleton.chain(head)) ^ set(skeleton.chain(ankle))
+        rise = rest[head, 2] - rest[ankle, 2]
+        if rise < UPRIGHT_RATIO * lengths[list(path)].sum():
+            raise BodyError(
+                f"the rest pose of skeleton {skeleton.name!r} is not upright (head "
+                f"{rise:.3f} m above the {side} ankle along {lengths[list(path)].sum():.3f} m "
+                "of bones); the body needs a rest pose that stands, Z up"
+            )
 
 
 class _FootFrame(NamedTuple):

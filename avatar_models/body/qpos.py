@@ -18,7 +18,8 @@ from avatar_models.motion import Motion
 
 def qpos_from_motion(desc: BodyDescription, motion: Motion) -> np.ndarray:
     """``(T, 7 + 3 * hinge joints)`` qpos for ``motion`` (which must be on ``desc``'s
-    skeleton, same joint names and parents)."""
+    skeleton, same joint names and parents). The root position is used as given: on a body
+    scaled away from the motion's skeleton the angles carry over, the positions do not."""
     if not motion.skeleton.same_topology(desc.skeleton):
         raise BodyError(
             f"motion skeleton {motion.skeleton!r} is not the body's skeleton {desc.skeleton!r}"

@@ -123,3 +123,9 @@ def test_bad_inputs_raise_body_error():
     with pytest.raises(BodyError, match="no known rig") as info:
         build_body(unknown)
     assert isinstance(info.value, AvatarsimError)
+
+
+def test_a_rest_pose_that_does_not_stand_is_refused():
+    # bandai.toml keeps the BVH's baked joint orientations: its rest pose is a crumpled heap.
+    with pytest.raises(BodyError, match="not upright"):
+        build_body(load_rig("bandai").skeleton)

@@ -173,3 +173,20 @@ def test_non_adjacent_segments_collide_adjacent_do_not():
         )
     }
     assert frozenset((model.body("l_hip").id, model.body("l_knee").id)) in excluded
+
+
+@pytest.mark.mocap
+def test_qpos_replays_real_cmu_mocap_exactly(mocap_dir):
+    from avatar_models.formats import load_motion
+
+    motion = load_motion(mocap_dir / "cmu" / "09_01.bvh")[::12]
+    body = build_body(motion.skeleton)
+    assert body.rig.name == "cmu"
+    model, data = _model(body)
+    qpos = body.qpos_from_motion(motion)
+    expected = motion.global_positions()[:, body.simulated_joints]
+    body_ids = [model.body(motion.skeleton.names[j]).id for j in body.simulated_joints]
+    for t in range(motion.n_frames):
+        data.qpos[:] = qpos[t]
+        mujoco.mj_kinematics(model, data)
+        np.testing.assert_allclose(data.xpos[body_ids], expected[t], atol=1e-6)
