@@ -85,7 +85,7 @@ def squat(scene: Scene) -> Plan:
     amp = min(scene.style.amplitude, 1.1)
     feet = planted_feet(scene, width=1.5)
     legs, toes = leg_targets(scene, feet, (1.0, 0.35, 0.0))
-    root = _rest_root(scene, depth * 0.4 * amp * scene.leg_length)
+    root = _rest_root(scene, depth * 0.45 * amp * scene.leg_length)
     root[:, 0] -= depth * 0.1 * height * amp
     pelvis = axis_rotation(Y_AXIS, depth * np.radians(15.0))
     root = reachable_root(scene, root, pelvis, feet)
