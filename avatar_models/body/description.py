@@ -190,7 +190,8 @@ def build_body(
 
     Raises:
         BodyError: unknown skeleton, height not in (0, 3] m, mass not positive, unknown foot
-            shape or segment kind, non-positive scale factor.
+            shape or segment kind, non-positive scale factor, a rest pose that does not
+            stand upright.
     """
     if not (np.isfinite(mass_kg) and mass_kg > 0):
         raise BodyError(f"body mass must be a positive number of kg, got {mass_kg!r}")

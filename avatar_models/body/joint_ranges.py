@@ -17,15 +17,18 @@ Degrees are the AAOS average ranges of motion (Greene & Heckman 1994, *The Clini
 Measurement of Joint Motion*, AAOS; the same values as AAOS 1965, *Joint Motion: Method of
 Measuring and Recording*): hip flexion 120 / extension 30 / abduction 45 / adduction 30 /
 internal and external rotation 45; knee flexion 135 (+10 hyperextension); ankle
-plantarflexion 50 / dorsiflexion 20, inversion 35 / eversion 15; shoulder abduction 180 /
+plantarflexion 50, inversion 35 / eversion 15; shoulder abduction 180 /
 adduction 30, horizontal flexion 135 / extension 45, internal rotation 70 / external 90;
 elbow flexion 150, pronation and supination 80; wrist flexion 80 / extension 70, radial
 deviation 20 / ulnar 30; thoracolumbar spine flexion 80 / extension 25 / lateral bending 35 /
 rotation 45; cervical spine flexion 45 / extension 45 / lateral bending 45 / rotation 60.
-Sternoclavicular ranges are Kapandji (*The Physiology of the Joints*, vol. 1): elevation 45,
-depression 10, protraction 15, retraction 30, axial rotation 30. Shoulder abduction is
-measured from the arm at the side, the rig's rest pose has the arm horizontal (T-pose), so
-rx = abduction - 90.
+Ankle dorsiflexion is the weight-bearing value, 40 degrees (lunge test, Bennell et al. 1998,
+Aust. J. Physiother. 44(3):175-180), not AAOS's non-weight-bearing 20: the body squats and
+walks under load. Sternoclavicular ranges are Kapandji (*The Physiology of the Joints*,
+vol. 1): elevation 45, depression 10, protraction 15, retraction 30, axial rotation 30.
+Shoulder abduction is measured from the arm at the side, the rest pose has the arm
+horizontal (T-pose), so rx = abduction - 90. Elbow flexion is about Z because the rest pose
+has the palms down.
 
 Degrees of freedom a joint does not have anatomically (knee and elbow varus/valgus, wrist
 axial rotation, the pelvic girdle) get a small allowance so the hinge still exists for
@@ -40,8 +43,6 @@ from __future__ import annotations
 
 import numpy as np
 
-AXES = ("x", "y", "z")
-
 # role -> (Euler order of the hinges, {axis: (lo, hi) degrees, left side}, shared by a chain)
 ROLE_TABLE: dict[str, tuple[str, dict[str, tuple[float, float]], bool]] = {
     "root_chain": ("YXZ", {"x": (-180, 180), "y": (-180, 180), "z": (-180, 180)}, False),
@@ -50,7 +51,7 @@ ROLE_TABLE: dict[str, tuple[str, dict[str, tuple[float, float]], bool]] = {
     "pelvic_girdle": ("YXZ", {"x": (-5, 5), "y": (-5, 5), "z": (-5, 5)}, True),
     "hip": ("YXZ", {"x": (-30, 45), "y": (-120, 30), "z": (-45, 45)}, False),
     "knee": ("YXZ", {"x": (-5, 5), "y": (-10, 135), "z": (-30, 40)}, False),
-    "ankle": ("YXZ", {"x": (-35, 15), "y": (-20, 50), "z": (-20, 10)}, False),
+    "ankle": ("YXZ", {"x": (-35, 15), "y": (-40, 50), "z": (-20, 10)}, False),
     "shoulder_girdle": ("XZY", {"x": (-10, 45), "y": (-30, 30), "z": (-15, 30)}, True),
     "shoulder": ("XZY", {"x": (-120, 90), "y": (-90, 70), "z": (-135, 45)}, False),
     "elbow": ("ZXY", {"x": (-5, 5), "y": (-80, 80), "z": (-150, 10)}, True),
