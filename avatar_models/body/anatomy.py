@@ -17,13 +17,9 @@ import numpy as np
 from avatar_models.rigs import Rig
 from avatar_models.skeleton import Skeleton
 
-# Along a limb chain, body17 joint -> role from that joint down to the next body17 joint.
-_LIMB_ROLES = {
-    "leg": (("hip", "hip"), ("knee", "knee"), ("ankle", "ankle")),
-    "arm": (("shoulder", "shoulder"), ("elbow", "elbow"), ("wrist", "wrist")),
-}
+# The body17 joints of a limb; each names the role of the joints from it down to the next.
+_LIMB_JOINTS = {"leg": ("hip", "knee", "ankle"), "arm": ("shoulder", "elbow", "wrist")}
 _GIRDLE = {"leg": "pelvic_girdle", "arm": "shoulder_girdle"}
-_END = {"leg": "ankle", "arm": "wrist"}
 
 # Role of a bone's proximal joint -> the segment kind of the bone.
 _BONE_KIND = {
@@ -71,7 +67,7 @@ def classify(skeleton: Skeleton, rig: Rig) -> Anatomy:
     pelvis_chain = set(skeleton.chain(b["pelvis"]))
     head_chain = skeleton.chain(b["head"])
     limb_chains = {
-        (side, limb): skeleton.chain(b[f"{side[0]}_{_END[limb]}"])
+        (side, limb): skeleton.chain(b[f"{side[0]}_{_LIMB_JOINTS[limb][-1]}"])
         for side in ("left", "right")
         for limb in ("leg", "arm")
     }
@@ -89,7 +85,7 @@ def classify(skeleton: Skeleton, rig: Rig) -> Anatomy:
     arm_path: set[int] = set()
     for (side, limb), chain in limb_chains.items():
         role = _GIRDLE[limb]
-        marks = {b[f"{side[0]}_{name}"]: r for name, r in _LIMB_ROLES[limb]}
+        marks = {b[f"{side[0]}_{name}"]: name for name in _LIMB_JOINTS[limb]}
         for j in chain:
             if j in roles and j not in marks:
                 continue
