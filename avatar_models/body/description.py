@@ -295,7 +295,10 @@ class _Layout:
         self.stature = float(top - sole)
 
     def _foot_frame(self, side: str, height: float) -> _FootFrame:
-        """Where the foot of ``side`` (``"l"``/``"r"``) lies in its ankle frame."""
+        """Where the foot of ``side`` (``"l"``/``"r"``) lies in its ankle frame: pointing at
+        the toe joint, ANSUR foot length with a quarter behind the ankle (or back to a heel
+        joint), top at the ankle, sole at the lowest foot joint but at least half a foot
+        breadth below the ankle."""
         ankle = self.an.body17[f"{side}_ankle"]
         toe = self.rest[self.an.body17[f"{side}_foot"]] - self.rest[ankle]
         heading = float(np.arctan2(toe[1], toe[0])) if np.hypot(toe[0], toe[1]) > 1e-9 else 0.0
