@@ -1,51 +1,35 @@
-"""The ``avatarsim`` command line (typer). Exit codes: 0 ok, 1 a check failed, 2 bad input."""
+"""The ``avatarsim`` command line (typer). Exit codes: 0 ok, 1 a check failed, 2 bad input.
+
+Core commands live here; capability commands (``check``, ``eval``, ``render``...) live in
+``scripts/commands/*.py`` as ``register(app)`` and are discovered at import.
+"""
 
 from __future__ import annotations
 
 import dataclasses
-import functools
+import importlib
+import pkgutil
 import sys
-from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Any
 
 import typer
-from rich.console import Console
 from rich.table import Table
 
+import scripts.commands
 from avatar_models.errors import AvatarsimError
-
-app = typer.Typer(
-    add_completion=False,
-    no_args_is_help=True,
-    help="avatarsim: a MuJoCo-grounded simulation testbed for full-body VR avatars.",
+from scripts.cli_common import (
+    JsonOpt,
+    SeedOpt,
+    console,
+    emit_json,
+    err_console,
+    make_app,
+    unit_option,
+    user_errors,
 )
-console = Console()
-err_console = Console(stderr=True)
 
-JsonOpt = Annotated[Path | None, typer.Option("--json", help="Also write the result as JSON here.")]
-SeedOpt = Annotated[int, typer.Option("--seed", help="Seed for everything stochastic.")]
-
-
-def user_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
-    """Turn avatarsim's typed errors into a one-line reason on stderr and exit code 2."""
-
-    @functools.wraps(fn)
-    def wrapper(*args: Any, **kwargs: Any) -> Any:
-        try:
-            return fn(*args, **kwargs)
-        except AvatarsimError as exc:
-            err_console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
-            raise typer.Exit(2) from None
-
-    return wrapper
-
-
-def emit_json(path: Path | None, payload: dict[str, Any]) -> None:
-    if path is not None:
-        from scripts.results import write_json
-
-        write_json(path, payload)
+app = make_app()
 
 
 @app.command()
@@ -62,7 +46,7 @@ def info(
     from avatar_models.formats import load_motion
     from avatar_models.measure import standing_height
 
-    m = load_motion(motion, **_unit_option(unit))
+    m = load_motion(motion, **unit_option(unit))
     payload = {
         "path": str(motion),
         "joints": m.skeleton.n_joints,
@@ -80,15 +64,6 @@ def info(
     emit_json(json_out, payload)
 
 
-def _unit_option(unit: str | None) -> dict[str, Any]:
-    if unit is None:
-        return {}
-    try:
-        return {"unit": float(unit)}
-    except ValueError:
-        return {"unit": unit}
-
-
 @app.command()
 @user_errors
 def convert(
@@ -102,7 +77,7 @@ def convert(
     """Convert BVH / ASF+AMC / NPZ to BVH or NPZ, optionally resampled."""
     from avatar_models.formats import load_motion, save_motion
 
-    m = load_motion(src, **_unit_option(unit))
+    m = load_motion(src, **unit_option(unit))
     if fps is not None:
         m = m.resample(fps)
     save_motion(m, dst)
@@ -188,6 +163,10 @@ def bench(
     console.print(table)
     payload = {"benchmarks": [r.to_json() for r in rows]}
     emit_json(json_out or Path("out/bench/bench.json"), payload)
+
+
+for _module in pkgutil.iter_modules(scripts.commands.__path__):
+    importlib.import_module(f"scripts.commands.{_module.name}").register(app)
 
 
 def main() -> None:  # pragma: no cover - console entry point

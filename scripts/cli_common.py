@@ -1,0 +1,63 @@
+"""Shared pieces of the ``avatarsim`` commands: the app, consoles, options, error handling.
+
+Command modules in ``scripts/commands/`` import from here and define ``register(app)``; the
+CLI discovers them, so adding a command never edits ``cli.py``.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.console import Console
+
+from avatar_models.errors import AvatarsimError
+
+
+def make_app() -> typer.Typer:
+    return typer.Typer(
+        add_completion=False,
+        no_args_is_help=True,
+        help="avatarsim: a MuJoCo-grounded simulation testbed for full-body VR avatars.",
+    )
+
+
+console = Console()
+err_console = Console(stderr=True)
+
+JsonOpt = Annotated[Path | None, typer.Option("--json", help="Also write the result as JSON here.")]
+SeedOpt = Annotated[int, typer.Option("--seed", help="Seed for everything stochastic.")]
+
+
+def user_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """Turn avatarsim's typed errors into a one-line reason on stderr and exit code 2."""
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        try:
+            return fn(*args, **kwargs)
+        except AvatarsimError as exc:
+            err_console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
+            raise typer.Exit(2) from None
+
+    return wrapper
+
+
+def emit_json(path: Path | None, payload: dict[str, Any]) -> None:
+    if path is not None:
+        from scripts.results import write_json
+
+        write_json(path, payload)
+
+
+def unit_option(unit: str | None) -> dict[str, Any]:
+    """``--unit`` as reader options: a unit name or a number of metres per file unit."""
+    if unit is None:
+        return {}
+    try:
+        return {"unit": float(unit)}
+    except ValueError:
+        return {"unit": unit}

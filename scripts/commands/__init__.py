@@ -1,0 +1,1 @@
+"""Capability commands of the CLI: each module defines ``register(app: typer.Typer)``."""
