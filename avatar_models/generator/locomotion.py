@@ -55,6 +55,8 @@ def _gait_plan(scene: Scene, gait: Gait) -> tuple[Plan, np.ndarray]:
     speed = np.clip(gait.stride * height * np.sqrt(style.amplitude) * frequency, *gait.speed_range)
     stride = speed / frequency
     swing_amp = np.radians(gait.arm_swing) * style.amplitude
+    # The clip starts part-way into the gait (seeded start time); shift it to start at x = 0.
+    start_x = speed * t[0]
     tracks = []
     for side, offset in (("L", 0.0), ("R", 0.5)):
         ankle_rest = scene.rest(f"Bip01 {side} Foot")
@@ -62,7 +64,7 @@ def _gait_plan(scene: Scene, gait: Gait) -> tuple[Plan, np.ndarray]:
         def plant_at(
             k: np.ndarray, off: float = offset, rest: np.ndarray = ankle_rest
         ) -> np.ndarray:
-            x = stride * (k + gait.duty / 2 - off) - 0.04 * height
+            x = stride * (k + gait.duty / 2 - off) - 0.04 * height - start_x
             return np.stack([x, np.full(k.shape, 0.85 * rest[1]), np.full(k.shape, rest[2])], 1)
 
         tracks.append(
@@ -86,7 +88,9 @@ def _gait_plan(scene: Scene, gait: Gait) -> tuple[Plan, np.ndarray]:
         )
     )
     root_rot = heading_rotation(0.0, n)
-    root_xy = np.stack([speed * t, 0.02 * height * np.cos(mid_stance) * (1 - gait.running)], 1)
+    root_xy = np.stack(
+        [speed * t - start_x, 0.02 * height * np.cos(mid_stance) * (1 - gait.running)], 1
+    )
     rest_z = scene.skeleton.offsets[0, 2]
     bob = gait.bob * height * style.amplitude * np.cos(2 * mid_stance)
     nominal = (

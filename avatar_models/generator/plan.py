@@ -26,7 +26,7 @@ MIRROR = np.diag([1.0, -1.0, 1.0])
 # Middle-joint hinge axes (local frame) signed so that a positive angle flexes the joint.
 KNEE_HINGE = np.array([0.0, 1.0, 0.0])
 ELBOW_HINGE = {"L": np.array([0.0, 0.0, -1.0]), "R": np.array([0.0, 0.0, 1.0])}
-# Full-fist flexion (radians) of the finger joints, proximal to distal; thumb smaller.
+# Full-fist flexion (degrees) of the finger joints, proximal to distal; thumb smaller.
 FIST_DEG = {"": 80.0, "1": 95.0, "2": 65.0}
 THUMB_FIST_DEG = {"0": 15.0, "01": 35.0, "02": 50.0}
 # Flexion axes in the left hand's frame (fingers point +Y, palm down): fingertips move to -Z.
@@ -34,14 +34,10 @@ FINGER_AXIS = np.array([-1.0, 0.0, 0.0])
 THUMB_AXIS = np.array([-0.8, 0.5, 0.0]) / np.hypot(0.8, 0.5)
 
 
-def mirrored(rot: np.ndarray) -> np.ndarray:
-    """``(..., 3, 3)`` rotations mirrored left <-> right (conjugated by the sagittal reflection)."""
-    return MIRROR @ rot @ MIRROR
-
-
 def sided(rot_left: np.ndarray, side: str) -> np.ndarray:
-    """A rotation written for the left side, as it applies to ``side``."""
-    return rot_left if side == "L" else mirrored(rot_left)
+    """``(..., 3, 3)`` rotations written for the left side, as they apply to ``side`` (the
+    right side gets the mirror image, conjugated by the sagittal reflection)."""
+    return rot_left if side == "L" else MIRROR @ rot_left @ MIRROR
 
 
 @dataclass(frozen=True)
@@ -73,11 +69,6 @@ class Scene:
     def leg_length(self) -> float:
         """Hip to ankle with the knee straight."""
         return float(sum(np.linalg.norm(self.offset(f"Bip01 L {j}")) for j in ("Calf", "Foot")))
-
-    @property
-    def arm_length(self) -> float:
-        """Shoulder to wrist with the elbow straight."""
-        return float(sum(np.linalg.norm(self.offset(f"Bip01 L {j}")) for j in ("Forearm", "Hand")))
 
     def constant(self, rot: np.ndarray) -> np.ndarray:
         """``(T, 3, 3)`` copies of one rotation."""

@@ -29,7 +29,7 @@ def swim(scene: Scene) -> Plan:
     prone = axis_rotation(Y_AXIS, np.full(n, np.pi / 2))
     root_rot = axis_rotation(X_AXIS, roll) @ prone
     speed = 1.0 * style.tempo * np.sqrt(amp)
-    root = np.column_stack([speed * t, np.zeros(n), np.full(n, 0.5 * height)])
+    root = np.column_stack([speed * (t - t[0]), np.zeros(n), np.full(n, 0.5 * height)])
     joints = {}
     for side, offset in (("L", 0.0), ("R", 0.5)):
         u = (cycle + offset) % 1.0

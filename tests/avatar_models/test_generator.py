@@ -257,3 +257,19 @@ def test_planned_contacts_match_measured_contacts(clips, activity):
     measured = np.stack([foot_slide(motion, s)[0] for s in "LR"], axis=1)
     agreement = (measured == motion.meta["planned_contacts"]).mean()
     assert agreement > 0.85, agreement
+
+
+def test_head_is_stabilised_upright_while_walking_and_running(clips):
+    for activity in ("walk", "run"):
+        motion = clips[activity, 0]
+        head_rot = motion.fk()[1][:, motion.skeleton.index("Bip01 Head")]
+        tilt = np.degrees(np.arccos(np.clip(head_rot[:, 2, 2], -1.0, 1.0)))  # head up vs world up
+        assert tilt.max() < 20.0, (activity, tilt.max())
+
+
+def test_boxer_makes_fists(clips):
+    motion = clips["box", 0]
+    pos, rest = motion.global_positions(), motion.skeleton.rest_positions()
+    tip, wrist = motion.skeleton.indices(["Bip01 L Finger2Nub", "Bip01 L Hand"])
+    closed = np.linalg.norm(pos[:, tip] - pos[:, wrist], axis=-1)
+    assert closed.max() < 0.7 * np.linalg.norm(rest[tip] - rest[wrist])
