@@ -30,14 +30,11 @@ def _rest_root(scene: Scene, drop: np.ndarray | float = 0.0) -> np.ndarray:
     return np.column_stack([np.zeros(n), np.zeros(n), np.broadcast_to(z, (n,))])
 
 
-def _hanging_arms(
-    scene: Scene, swing: float = 0.0, abduction: float = 8.0, elbow: float = 12.0
-) -> dict:
+def _hanging_arms(scene: Scene, sides: str = "LR") -> dict[str, np.ndarray]:
+    """Relaxed arms hanging at the sides (8 deg abduction, 12 deg elbow flexion)."""
     out = {}
-    for side in "LR":
-        out.update(
-            arm_angles(scene, side, np.radians(swing), np.radians(abduction), np.radians(elbow))
-        )
+    for side in sides:
+        out.update(arm_angles(scene, side, 0.0, np.radians(8.0), np.radians(12.0)))
     return out
 
 
@@ -60,8 +57,7 @@ def wave(scene: Scene) -> Plan:
     # Palm forward, fingers up, the hand tilting with the wave about the forward axis.
     palm_forward = np.array([[0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
     hand_rot = axis_rotation(X_AXIS, -0.35 * wag) @ palm_forward
-    joints = {**_hanging_arms(scene), **toes}
-    del joints["Bip01 R UpperArm"], joints["Bip01 R Forearm"]
+    joints = {**_hanging_arms(scene, sides="L"), **toes}
     return Plan(
         root_pos=reachable_root(
             scene, _rest_root(scene, 0.01 * height), scene.constant(np.eye(3)), feet
