@@ -1,0 +1,27 @@
+"""CoolMoves (Ahuja et al., IMWUT 2021): full-body motion accentuation from a VR headset and two
+controllers, by nearest-neighbour matching of 100 ms hand windows into a stylised database.
+
+One concept per module: :mod:`.features` (windows, features, speed augmentation),
+:mod:`.correlation` (hand-foot Pearson filter), :mod:`.database`, :mod:`.knn`, :mod:`.gmm`
+(the mixture-model variant), :mod:`.alignment`, :mod:`.blend`, :mod:`.smoothing`,
+:mod:`.limits`, :mod:`.synthesizer`, :mod:`.applications` and :mod:`.accuracy`.
+"""
+
+from synthesis.coolmoves.database import (
+    FEET_DRIVE,
+    HANDS_DRIVE,
+    Database,
+    Drivers,
+    build_database,
+)
+from synthesis.coolmoves.synthesizer import CoolMoves, Options
+
+__all__ = [
+    "FEET_DRIVE",
+    "HANDS_DRIVE",
+    "CoolMoves",
+    "Database",
+    "Drivers",
+    "Options",
+    "build_database",
+]

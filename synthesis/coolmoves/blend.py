@@ -1,0 +1,92 @@
+"""Blending the aligned matches into one pose (CoolMoves §3.1.4).
+
+- Each match gets a "normalized weight (between 0 and 1) ... inversely proportional to the
+  distance error": ``w_i = (1 / d_i) / sum_j (1 / d_j)`` over the matches of one hand.
+- "The left and right arm's motion will be governed by their respective hand's motion":
+  joints of the left limb take the left-hand weights only, the right limb the right-hand ones,
+  "for all the other joints ... a weighted average between the left and right arm weights".
+  We weight that average by each hand's match confidence (below), so that a hand without
+  good matches (or untracked) leaves the trunk and legs to the other.
+- "We also average out the weights of all the joints to compute a global match weight": the
+  paper does not say how a joint's weight becomes one number in [0, 1]. Ours: a hand's
+  confidence is the weighted mean of ``1 - d_i / max_distance`` over its matches (1 for an
+  exact match, 0 at the KD-tree threshold); a limb joint has its hand's confidence, every
+  other joint the mean of both, and the global match weight is the mean over all joints.
+
+Shapes: ``B`` queries, ``k`` matches per hand, ``M = 2k`` (left matches first), ``J`` joints.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+_EPS_M = 1e-9  # keeps an exact (distance 0) match finite; it then takes all the weight
+
+
+def inverse_distance_weights(dist: np.ndarray) -> np.ndarray:
+    """``(B, k)`` weights proportional to ``1 / d`` summing to 1 (0 for missing, ``inf``)."""
+    dist = np.asarray(dist, float)
+    d_min = np.min(dist, axis=-1, keepdims=True)
+    # 1/(d + eps) relative to the best match, so that an exact match cannot overflow.
+    inv = np.where(np.isfinite(dist), (d_min + _EPS_M) / (dist + _EPS_M), 0.0)
+    inv = np.where(np.isfinite(d_min), inv, 0.0)
+    total = inv.sum(axis=-1, keepdims=True)
+    return np.divide(inv, total, out=np.zeros_like(inv), where=total > 0)
+
+
+def hand_confidence(dist: np.ndarray, weights: np.ndarray, max_distance: float) -> np.ndarray:
+    """``(B,)`` weighted mean of ``1 - d / max_distance`` over one hand's matches."""
+    closeness = np.clip(1.0 - np.nan_to_num(dist, posinf=max_distance) / max_distance, 0.0, 1.0)
+    return np.sum(weights * closeness, axis=-1)
+
+
+def group_weights(
+    dist_left: np.ndarray, dist_right: np.ndarray, max_distance: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Match weights per joint group and each group's confidence.
+
+    Returns:
+        weights ``(B, 3, M)``: rows for the left limb, the right limb and the rest; each row
+        sums to 1 or is all 0 (no match for that group).
+        confidence ``(B, 3)`` in [0, 1] for the same groups.
+    """
+    wl, wr = inverse_distance_weights(dist_left), inverse_distance_weights(dist_right)
+    ql = hand_confidence(dist_left, wl, max_distance)
+    qr = hand_confidence(dist_right, wr, max_distance)
+    zl, zr = np.zeros_like(wl), np.zeros_like(wr)
+    has_l, has_r = wl.sum(-1) > 0, wr.sum(-1) > 0
+    # Trunk and legs: both hands, by confidence; equal shares when both are at the threshold.
+    share_l = np.where(ql + qr > 0, ql / np.maximum(ql + qr, 1e-300), 0.5)
+    share_l = np.where(has_l & has_r, share_l, has_l.astype(float))
+    rest = np.concatenate([share_l[:, None] * wl, (1.0 - share_l)[:, None] * wr], axis=-1)
+    weights = np.stack([np.concatenate([wl, zr], -1), np.concatenate([zl, wr], -1), rest], axis=1)
+    count = has_l.astype(float) + has_r
+    rest_conf = np.divide(ql + qr, count, out=np.zeros_like(ql), where=count > 0)
+    return weights, np.stack([ql, qr, rest_conf], axis=1)
+
+
+def joint_groups(limb_masks: np.ndarray) -> np.ndarray:
+    """``(J,)`` group of each joint: 0 left limb, 1 right limb, 2 the rest."""
+    return np.where(limb_masks[0], 0, np.where(limb_masks[1], 1, 2))
+
+
+def global_match_weight(confidence: np.ndarray, groups: np.ndarray) -> np.ndarray:
+    """``(B,)`` mean over all joints of their group's confidence."""
+    counts = np.bincount(groups, minlength=3).astype(float)
+    return confidence @ (counts / counts.sum())
+
+
+def blend_rotations(rotations: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """Weighted average of unit quaternions ``(B, M, J, 4)`` with weights ``(B, J, M)``.
+
+    Each match is first flipped into the hemisphere of the joint's heaviest match, then the
+    weighted sum is normalised (the chordal mean, accurate for the nearby rotations that
+    matches of one query are). Joints with no weight get a zero quaternion; callers keep their
+    previous rotation there.
+    """
+    heaviest = np.argmax(weights, axis=-1)  # (B, J)
+    ref = np.take_along_axis(rotations, heaviest[:, None, :, None], axis=1)  # (B, 1, J, 4)
+    sign = np.where(np.sum(rotations * ref, axis=-1) < 0, -1.0, 1.0)  # (B, M, J)
+    summed = np.einsum("bjm,bmj,bmjc->bjc", weights, sign, rotations)
+    norm = np.linalg.norm(summed, axis=-1, keepdims=True)
+    return np.divide(summed, norm, out=np.zeros_like(summed), where=norm > 1e-12)

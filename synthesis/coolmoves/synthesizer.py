@@ -1,0 +1,282 @@
+"""``CoolMoves``: full-body accentuation from a headset and two hand controllers (§3.1).
+
+Per 90 Hz sample: the last 100 ms of each hand, head-relative, is matched in the database
+(one KD-tree per hand, :mod:`.knn`); every match is turned about the vertical to fit the
+input (:mod:`.alignment`); the matched poses are blended, arms from their own hand
+(:mod:`.blend`); the result is smoothed by an EWMA weighted by the global match weight
+(:mod:`.smoothing`); joint angles are thresholded (:mod:`.limits`); bones are scaled to the
+user's height and the body is placed so that its headset point is the input headset's.
+
+Order of the last steps: the paper scales and translates before thresholding; we threshold
+first, so that the headset point of the final pose is exactly the tracked one.
+
+Invalid input: a hand is matched only when its whole window (and the headset) was tracked;
+a side without matches holds its limb (EWMA weight 0), with no match at all the whole pose
+holds, and the translation holds the last tracked headset position. Late or repeated
+timestamps are ignored by ``step``; ``run`` repairs and re-clocks the stream first.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from avatar_models import Motion, Skeleton, quat
+from avatar_models.measure import standing_height
+from avatar_models.rigs import identify_rig
+from render_cams import TrackingStream
+from render_cams.vr import nominal_attachment
+from synthesis.base import Pose, SynthesisError, Synthesizer, TrackingFrame, on_clock, usable_mask
+from synthesis.coolmoves.alignment import alignment_yaw
+from synthesis.coolmoves.blend import (
+    blend_rotations,
+    global_match_weight,
+    group_weights,
+    joint_groups,
+)
+from synthesis.coolmoves.database import Database
+from synthesis.coolmoves.features import search_vectors, sliding_windows
+from synthesis.coolmoves.knn import K_NEIGHBOURS, MAX_DISTANCE, KNNMatcher
+from synthesis.coolmoves.limits import JointLimits
+from synthesis.coolmoves.smoothing import ewma, ewma_step
+
+_Z = np.array([0.0, 0.0, 1.0])
+
+
+@dataclass(frozen=True)
+class Options:
+    """Switches of the method (the paper's ablation turns off alignment and smoothing).
+
+    Attributes:
+        k: matches per hand. max_distance: KD-tree neighbourhood threshold.
+        align: rotation alignment (§3.1.4). smooth: EWMA smoothing. clamp: joint limits.
+        matcher: ``"knn"`` (the paper's method) or ``"gmm"`` (the slower mixture variant).
+    """
+
+    k: int = K_NEIGHBOURS
+    max_distance: float = MAX_DISTANCE
+    align: bool = True
+    smooth: bool = True
+    clamp: bool = True
+    matcher: str = "knn"
+
+
+class CoolMoves(Synthesizer):
+    """The CoolMoves synthesiser on a built :class:`Database`.
+
+    Args:
+        database: stylised poses and their hand windows.
+        user_height_m: the user's standing height; None estimates it from the first tracked
+            headset height (assuming the user stands then).
+        options: method switches.
+    """
+
+    name = "coolmoves"
+
+    def __init__(
+        self,
+        database: Database,
+        user_height_m: float | None = None,
+        options: Options | None = None,
+    ):
+        self.database = database
+        self.options = options or Options()
+        self.user_height_m = user_height_m
+        self._matchers = self._make_matchers()
+        self._groups = joint_groups(database.limb_masks)
+        self._limits = JointLimits(database.skeleton)
+        ref = database.skeleton
+        rig = identify_rig(ref)
+        self._head_chain = ref.chain(ref.index(rig.body17["head"]))
+        self._eye = nominal_attachment(database.drivers.head, ref).position
+        rest = ref.rest_positions()
+        head_rest = rest[self._head_chain[-1]] + self._eye
+        self._ref_height = standing_height(ref)
+        self._ref_hmd_height = float(head_rest[2] - rest[:, 2].min())
+        self.reset()
+
+    def _make_matchers(self) -> list:
+        opts, db = self.options, self.database
+        if opts.matcher == "knn":
+            return [KNNMatcher(db.search[s], opts.k, opts.max_distance) for s in (0, 1)]
+        if opts.matcher == "gmm":
+            from synthesis.coolmoves.gmm import GaussianMixtureMatcher
+
+            return [GaussianMixtureMatcher(db.search[s], opts.k, opts.max_distance) for s in (0, 1)]
+        raise SynthesisError(f"unknown matcher {opts.matcher!r}; use 'knn' or 'gmm'")
+
+    # -- state ----------------------------------------------------------------------------
+    def reset(self) -> None:
+        n = self.database.window_samples
+        self._window = np.full((n, 2, 3), np.nan)
+        self._tracked = np.zeros((n, 2), bool)
+        self._state = self.database.mean_pose.copy()
+        self._initialised = np.zeros(self.database.skeleton.n_joints, bool)
+        self._hmd: np.ndarray | None = None
+        self._scale: float | None = self._scale_for(self.user_height_m)
+        self._last_time: float | None = None
+        self._last_pose: Pose | None = None
+        self._device_index: tuple[tuple[str, ...], np.ndarray] | None = None
+
+    @property
+    def skeleton(self) -> Skeleton:
+        """The output rig: the database rig scaled to the user's height (once known)."""
+        return self.database.skeleton.scaled(self._scale or 1.0)
+
+    def _scale_for(self, height_m: float | None) -> float | None:
+        return None if height_m is None else float(height_m) / self._ref_height
+
+    def _scale_from_hmd(self, hmd_z: float) -> float:
+        """Bone scale from a standing headset height (the reference rig's HMD height ratio)."""
+        return self._scale_for(hmd_z * self._ref_height / self._ref_hmd_height)
+
+    def _devices(self, names: tuple[str, ...]) -> np.ndarray:
+        """Indices of (head, left, right) drivers in a stream's device list, cached."""
+        if self._device_index is None or self._device_index[0] != names:
+            missing = [d for d in self.database.drivers.devices if d not in names]
+            if missing:
+                raise SynthesisError(f"CoolMoves needs devices {missing}; the stream has {names}")
+            index = np.array([names.index(d) for d in self.database.drivers.devices])
+            self._device_index = (names, index)
+        return self._device_index[1]
+
+    # -- the method, on a batch of windows ------------------------------------------------
+    def match(self, windows: np.ndarray, tracked: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Blended poses for ``B`` input windows, before smoothing.
+
+        Args:
+            windows: ``(B, n, 2, 3)`` head-relative left/right driver positions.
+            tracked: ``(B, 2)`` bool, whether each side's window is usable.
+        Returns:
+            rotations ``(B, J, 4)`` (zero where a joint got no match) and the EWMA weight
+            of each joint ``(B, J)``: the global match weight where it got matches, else 0.
+        """
+        db, opts = self.database, self.options
+        b, k = windows.shape[0], self._matchers[0].k
+        dist = np.full((2, b, k), np.inf)
+        idx = np.full((2, b, k), -1)
+        for side in (0, 1):
+            rows = np.flatnonzero(tracked[:, side])
+            if rows.size:
+                dist[side, rows], idx[side, rows] = self._matchers[side].query(
+                    search_vectors(windows[rows, :, side])
+                )
+        weights, confidence = group_weights(dist[0], dist[1], opts.max_distance)
+        entries = np.concatenate([idx[0], idx[1]], axis=1)  # (B, 2k)
+        safe = np.maximum(entries, 0)
+        rotations = db.poses[db.entry_pose[safe]]  # (B, 2k, J, 4)
+        if opts.align:
+            yaw = alignment_yaw(windows, db.windows[safe], tracked)
+            rotations = rotations.copy()
+            rotations[:, :, 0] = quat.mul(quat.from_axis_angle(_Z, yaw), rotations[:, :, 0])
+        joint_weights = weights[:, self._groups, :]  # (B, J, 2k)
+        blended = blend_rotations(rotations, joint_weights)
+        matched = joint_weights.sum(axis=-1) > 0
+        strength = global_match_weight(confidence, self._groups) if opts.smooth else 1.0
+        return blended, np.where(matched, np.reshape(strength, (-1, 1)), 0.0)
+
+    def _place(self, rotations: np.ndarray, hmd: np.ndarray, scale: np.ndarray) -> np.ndarray:
+        """Root positions ``(B, 3)`` putting each pose's headset point at ``hmd (B, 3)``.
+
+        Forward kinematics along the root-to-head chain only, on the rig scaled by ``scale``.
+        """
+        ref = self.database.skeleton
+        chain = self._head_chain
+        glob = rotations[:, chain[0]]
+        pos = np.zeros((rotations.shape[0], 3))
+        for j in chain[1:]:
+            pos = pos + quat.rotate(glob, ref.offsets[j])
+            glob = quat.mul(glob, rotations[:, j])
+        head = scale[:, None] * pos + quat.rotate(glob, self._eye)
+        return hmd - head
+
+    def _finish(self, smoothed: np.ndarray, hmd: np.ndarray, scale: np.ndarray) -> tuple:
+        rotations = self._limits.clamp(smoothed) if self.options.clamp else smoothed
+        return rotations, self._place(rotations, hmd, scale)
+
+    def _default_hmd(self) -> np.ndarray:
+        return np.array([0.0, 0.0, self._ref_hmd_height])
+
+    # -- streaming ------------------------------------------------------------------------
+    def step(self, frame: TrackingFrame) -> Pose:
+        if self._last_time is not None and not frame.timestamp > self._last_time:
+            return self._last_pose  # a late or repeated sample: already past it
+        if np.isfinite(frame.timestamp):
+            self._last_time = float(frame.timestamp)
+        head, left, right = self._devices(frame.device_names)
+        ok = frame.usable()
+        sides_ok = ok[[left, right]] & ok[head]
+        self._window = np.roll(self._window, -1, axis=0)
+        self._tracked = np.roll(self._tracked, -1, axis=0)
+        self._window[-1] = np.where(
+            sides_ok[:, None], frame.positions[[left, right]] - frame.positions[head], np.nan
+        )
+        self._tracked[-1] = sides_ok
+        if ok[head]:
+            self._hmd = np.array(frame.positions[head], float)
+            if self._scale is None:
+                self._scale = self._scale_from_hmd(self._hmd[2])
+        window_ok = self._tracked.all(axis=0)
+        if window_ok.any():
+            blended, weight = self.match(self._window[None], window_ok[None])
+            blended, weight = blended[0], weight[0]
+            weight = np.where(self._initialised, weight, weight > 0)
+            self._state = ewma_step(self._state, blended, weight)
+            self._initialised |= weight > 0
+        hmd = self._default_hmd() if self._hmd is None else self._hmd
+        rotations, root = self._finish(self._state[None], hmd[None], np.array([self._scale or 1.0]))
+        self._last_pose = Pose(root[0], rotations[0])
+        return self._last_pose
+
+    # -- batch ----------------------------------------------------------------------------
+    def run(self, stream: TrackingStream) -> Motion:
+        """The whole stream at once; the same result as :meth:`step` on every clock tick."""
+        self.reset()
+        clocked = on_clock(stream)
+        n, t = self.database.window_samples, clocked.n_samples
+        head, left, right = self._devices(clocked.device_names)
+        ok = usable_mask(clocked)
+        sides_ok = ok[:, [left, right]] & ok[:, [head]]
+        rel = np.where(
+            sides_ok[..., None],
+            clocked.positions[:, [left, right]] - clocked.positions[:, [head]],
+            np.nan,
+        )
+        padded_rel = np.concatenate([np.full((n - 1, 2, 3), np.nan), rel])
+        padded_ok = np.concatenate([np.zeros((n - 1, 2), bool), sides_ok])
+        ends = np.arange(n - 1, n - 1 + t)
+        windows = sliding_windows(padded_rel, ends, n)  # (T, n, 2, 3)
+        window_ok = sliding_windows(padded_ok, ends, n).all(axis=1)  # (T, 2)
+        blended = np.zeros((t, self.database.skeleton.n_joints, 4))
+        weight = np.zeros((t, self.database.skeleton.n_joints))
+        rows = np.flatnonzero(window_ok.any(axis=1))
+        if rows.size:
+            blended[rows], weight[rows] = self.match(windows[rows], window_ok[rows])
+        # A joint's first match replaces the initial mean pose outright, as in step().
+        seen_before = np.concatenate(
+            [np.zeros((1, weight.shape[1]), bool), np.cumsum(weight > 0, axis=0)[:-1] > 0]
+        )
+        weight = np.where(seen_before, weight, weight > 0)
+        smoothed = ewma(blended, weight, self.database.mean_pose)
+        hmd, scale = self._hmd_track(clocked.positions[:, head], ok[:, head])
+        rotations, root = self._finish(smoothed, hmd, scale)
+        self._state = smoothed[-1]
+        return Motion(
+            self.skeleton,
+            float(clocked.meta["rate_hz"]),
+            root,
+            rotations,
+            meta={"method": self.name, "options": vars(self.options), "stream": clocked.meta},
+        )
+
+    def _hmd_track(self, hmd: np.ndarray, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Last tracked headset position per tick ``(T, 3)`` and the bone scale ``(T,)``."""
+        last = np.maximum.accumulate(np.where(ok, np.arange(ok.size), -1))
+        held = np.where((last >= 0)[:, None], hmd[np.maximum(last, 0)], self._default_hmd())
+        if self._scale is None and ok.any():
+            self._scale = self._scale_from_hmd(float(hmd[np.argmax(ok), 2]))
+        scale = np.where(last >= 0, self._scale or 1.0, 1.0)
+        if self.user_height_m is not None:
+            scale[:] = self._scale
+        return held, scale
