@@ -8,6 +8,7 @@ capability (devices, synthesis, physics checks) adds a stage and declares its me
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -21,12 +22,14 @@ from rich.console import Console
 
 from avatar_models.body import build_body
 from avatar_models.formats import load_motion, save_motion
-from avatar_models.generator import ACTIVITIES, Subject, generate, sample_subject
+from avatar_models.generator import ACTIVITIES, generate, sample_subject
 from avatar_models.motion import Motion
 from scripts.results import CheckResult, junit_xml, versions, write_atomic, write_json
 from scripts.scenario import Scenario, ScenarioError
 from sim.render import render_frames
 from sim.replay import replay_kinematic
+
+DEFAULT_MASS_KG = 75.0
 
 # metric name -> what it measures (unit in the name). Thresholds may name only these.
 METRICS: dict[str, str] = {
@@ -62,8 +65,8 @@ def motion_stage(ctx: RunContext) -> None:
             )
         rng = np.random.default_rng(ctx.scenario.seed)
         subject = sample_subject(rng)
-        if spec.height_m is not None:
-            subject = Subject(**{**subject.__dict__, "height_m": spec.height_m})
+        chosen = {"height_m": spec.height_m, "style": spec.style}
+        subject = dataclasses.replace(subject, **{k: v for k, v in chosen.items() if v is not None})
         motion = generate(
             spec.activity, subject, duration_s=spec.duration_s, fps=spec.fps, seed=ctx.scenario.seed
         )
@@ -84,17 +87,19 @@ def motion_stage(ctx: RunContext) -> None:
         "fps": motion.fps,
         "frames": motion.n_frames,
         "duration_s": motion.duration_s,
+        "subject": motion.meta.get("subject"),
     }
     ctx.output("motion_bvh", save_motion(motion, ctx.out_dir / "motion.bvh"))
 
 
 def body_stage(ctx: RunContext) -> None:
     spec = ctx.scenario.body
-    body = build_body(ctx.motion.skeleton, height_m=spec.height_m, mass_kg=spec.mass_kg)
+    mass_kg = spec.mass_kg or (ctx.motion.meta.get("subject") or {}).get("mass_kg", DEFAULT_MASS_KG)
+    body = build_body(ctx.motion.skeleton, height_m=spec.height_m, mass_kg=mass_kg)
     xml = body.to_mjcf()
     ctx.model = mujoco.MjModel.from_xml_string(xml)
     ctx.qpos = body.qpos_from_motion(ctx.motion)
-    ctx.info["body"] = {"mass_kg": spec.mass_kg, "nq": ctx.model.nq, "nbody": ctx.model.nbody}
+    ctx.info["body"] = {"mass_kg": mass_kg, "nq": ctx.model.nq, "nbody": ctx.model.nbody}
     ctx.output("mjcf", write_atomic(ctx.out_dir / "humanoid.xml", xml))
 
 

@@ -6,11 +6,11 @@ A scenario names a motion source, the body, the stages to run and pass/fail thre
     seed = 0
     [motion]
     source = "builtin"        # or a path to a .bvh / .amc / .npz file
-    activity = "walk"         # builtin only
+    activity = "walk"         # builtin only (also: height_m, style; sampled from seed if absent)
     duration_s = 4.0
     fps = 90.0
     [body]
-    mass_kg = 75.0
+    mass_kg = 75.0            # optional
     [report]
     picture_frames = 6
     [thresholds]              # metric = max allowed, or {min = x} / {max = x}
@@ -43,12 +43,13 @@ class MotionSpec:
     duration_s: float = 4.0
     fps: float = 90.0
     height_m: float | None = None
+    style: str | None = None
     unit: str | None = None
 
 
 @dataclass(frozen=True)
 class BodySpec:
-    mass_kg: float = 75.0
+    mass_kg: float | None = None  # None: the built-in subject's mass, else 75 kg
     height_m: float | None = None
 
 
@@ -138,7 +139,7 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
         raise ScenarioError("motion.duration_s and motion.fps must be positive")
     if motion.height_m is not None and not 1.0 <= motion.height_m <= 2.5:
         raise ScenarioError(f"motion.height_m={motion.height_m} is not a human height in metres")
-    if body.mass_kg <= 0:
+    if body.mass_kg is not None and body.mass_kg <= 0:
         raise ScenarioError("body.mass_kg must be positive")
     if report.picture_frames < 1:
         raise ScenarioError("report.picture_frames must be at least 1")
