@@ -56,7 +56,7 @@ def info(
         "duration_s": m.duration_s,
         "height_m": standing_height(m),
     }
-    table = Table(title=str(motion), show_header=False)
+    table = Table(title=motion.name, show_header=False)
     for key in ("joints", "fps", "frames", "duration_s", "height_m"):
         value = payload[key]
         table.add_row(key, f"{value:.3f}" if isinstance(value, float) else str(value))
