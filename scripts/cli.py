@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import typer
+from rich.markup import escape
 from rich.table import Table
 
 import scripts.commands
@@ -157,9 +158,9 @@ def bench(
     for col in ("name", "unit", "value", "baseline", "ratio"):
         table.add_column(col, justify="right" if col != "name" else "left")
     for r in rows:
-        base = "" if r.baseline is None else f"{r.baseline:.4g} ({r.baseline_name})"
+        base = "" if r.baseline is None else escape(f"{r.baseline:.4g} ({r.baseline_name})")
         ratio = "" if r.ratio is None else f"{r.ratio:.2f}x"
-        table.add_row(r.name, r.unit, f"{r.value:.4g}", base, ratio)
+        table.add_row(escape(r.name), r.unit, f"{r.value:.4g}", base, ratio)
     console.print(table)
     payload = {"benchmarks": [r.to_json() for r in rows]}
     emit_json(json_out or Path("out/bench/bench.json"), payload)
