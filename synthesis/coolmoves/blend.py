@@ -28,8 +28,8 @@ def inverse_distance_weights(dist: np.ndarray) -> np.ndarray:
     dist = np.asarray(dist, float)
     d_min = np.min(dist, axis=-1, keepdims=True)
     # 1/(d + eps) relative to the best match, so that an exact match cannot overflow.
-    inv = np.where(np.isfinite(dist), (d_min + _EPS_M) / (dist + _EPS_M), 0.0)
-    inv = np.where(np.isfinite(d_min), inv, 0.0)
+    usable = np.isfinite(dist)
+    inv = np.divide(d_min + _EPS_M, dist + _EPS_M, out=np.zeros_like(dist), where=usable)
     total = inv.sum(axis=-1, keepdims=True)
     return np.divide(inv, total, out=np.zeros_like(inv), where=total > 0)
 

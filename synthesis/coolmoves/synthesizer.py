@@ -182,13 +182,13 @@ class CoolMoves(Synthesizer):
         Forward kinematics along the root-to-head chain only, on the rig scaled by ``scale``.
         """
         ref = self.database.skeleton
-        chain = self._head_chain
-        glob = rotations[:, chain[0]]
+        mats = quat.to_matrix(rotations[:, self._head_chain])  # (B, L, 3, 3), one scipy call
+        glob = mats[:, 0]
         pos = np.zeros((rotations.shape[0], 3))
-        for j in chain[1:]:
-            pos = pos + quat.rotate(glob, ref.offsets[j])
-            glob = quat.mul(glob, rotations[:, j])
-        head = scale[:, None] * pos + quat.rotate(glob, self._eye)
+        for link, j in enumerate(self._head_chain[1:], start=1):
+            pos = pos + glob @ ref.offsets[j]
+            glob = glob @ mats[:, link]
+        head = scale[:, None] * pos + glob @ self._eye
         return hmd - head
 
     def _finish(self, smoothed: np.ndarray, hmd: np.ndarray, scale: np.ndarray) -> tuple:
@@ -207,8 +207,8 @@ class CoolMoves(Synthesizer):
         head, left, right = self._devices(frame.device_names)
         ok = frame.usable()
         sides_ok = ok[[left, right]] & ok[head]
-        self._window = np.roll(self._window, -1, axis=0)
-        self._tracked = np.roll(self._tracked, -1, axis=0)
+        self._window[:-1] = self._window[1:]
+        self._tracked[:-1] = self._tracked[1:]
         self._window[-1] = np.where(
             sides_ok[:, None], frame.positions[[left, right]] - frame.positions[head], np.nan
         )

@@ -1,0 +1,40 @@
+"""Small CoolMoves databases built from the procedural generator (a few seconds each)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from avatar_models.generator import Subject, generate
+from synthesis.coolmoves import build_database
+
+TRAIN_SUBJECTS = (
+    Subject(height_m=1.70, tempo=0.95, amplitude=1.05),
+    Subject(height_m=1.82, tempo=1.05, amplitude=0.95, style="happy"),
+)
+TEST_SUBJECT = Subject(height_m=1.76, tempo=1.0, amplitude=1.0)
+ACTIVITIES = ("box", "run")
+
+
+@pytest.fixture(scope="session")
+def train_motions():
+    return [
+        generate(a, s, 4.0, 90.0, seed=7 * i + j)
+        for i, s in enumerate(TRAIN_SUBJECTS)
+        for j, a in enumerate(ACTIVITIES)
+    ]
+
+
+@pytest.fixture(scope="session")
+def small_db(train_motions):
+    return build_database(train_motions)
+
+
+@pytest.fixture(scope="session")
+def test_motion():
+    return generate("box", TEST_SUBJECT, 4.0, 90.0, seed=99)
+
+
+def yaw_matrix(theta: float) -> np.ndarray:
+    c, s = np.cos(theta), np.sin(theta)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])

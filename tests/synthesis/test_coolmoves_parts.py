@@ -1,0 +1,203 @@
+"""Known-answer tests of the CoolMoves building blocks (features, filter, search, alignment,
+blending, smoothing, limits)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from avatar_models import quat
+from avatar_models.rigs import load_rig
+from synthesis.coolmoves import correlation
+from synthesis.coolmoves.alignment import alignment_yaw, ramp_weights
+from synthesis.coolmoves.blend import blend_rotations, group_weights, inverse_distance_weights
+from synthesis.coolmoves.features import (
+    feature_vectors,
+    search_vectors,
+    speed_windows,
+    window_stride,
+)
+from synthesis.coolmoves.knn import KNNMatcher
+from synthesis.coolmoves.limits import JointLimits
+from synthesis.coolmoves.smoothing import ewma, ewma_step
+from tests.synthesis.conftest import yaw_matrix
+
+
+def test_window_geometry_is_the_papers():
+    # 100 ms at 90 Hz = 9 samples, 50 ms overlap -> 5 shared samples, a new window every 4.
+    assert window_stride(9, 90.0) == 4
+    np.testing.assert_allclose(ramp_weights(9), np.arange(1, 10) / 9)
+    assert ramp_weights(9)[-1] == 1.0
+
+
+def test_search_vectors_preserve_feature_distances():
+    rng = np.random.default_rng(0)
+    a, b = rng.normal(size=(2, 50, 9, 3))
+    full = np.linalg.norm(feature_vectors(a) - feature_vectors(b), axis=-1)
+    reduced = np.linalg.norm(search_vectors(a) - search_vectors(b), axis=-1)
+    np.testing.assert_allclose(reduced, full, rtol=1e-10)
+    assert feature_vectors(a).shape == (50, 81) and search_vectors(a).shape == (50, 27)
+
+
+def test_features_of_constant_velocity_window():
+    # p_i = v * i / 90: velocity v everywhere, acceleration 0; W = 8/90 s.
+    v = np.array([0.9, -0.45, 0.18])
+    window = np.arange(9)[:, None] / 90.0 * v
+    f = feature_vectors(window).reshape(27, 3)
+    np.testing.assert_allclose(f[:9], window)
+    np.testing.assert_allclose(f[9:18], np.tile(v * 8 / 90, (9, 1)), atol=1e-12)
+    np.testing.assert_allclose(f[18:], 0.0, atol=1e-9)
+
+
+def test_speed_window_scales_velocity_and_keeps_last_sample():
+    series = (np.arange(40) ** 2 / 100.0)[:, None]  # x = t^2 / 100 (frames)
+    ends = np.array([20, 30])
+    for speed in (0.5, 1.0, 1.5):
+        w = speed_windows(series, ends, speed)
+        np.testing.assert_allclose(w[:, -1, 0], series[ends, 0])
+        # Sample i sits at frame end - speed * (8 - i).
+        expected_frames = ends[:, None] - speed * np.arange(8, -1, -1)[None]
+        exact = expected_frames**2 / 100.0
+        np.testing.assert_allclose(w[..., 0], exact, atol=0.01 * speed)  # linear interpolation
+
+
+def test_pearson_filter_by_hand():
+    a = np.array([1.0, 2.0, 3.0, 4.0])  # deviations -1.5 -0.5 0.5 1.5
+    b = np.array([1.0, 3.0, 2.0, 4.0])  # deviations -1.5 0.5 -0.5 1.5: r = 4 / 5 = 0.8
+    assert correlation.pearson(a, b) == pytest.approx(0.8)
+    hands, feet = np.zeros((2, 4, 2, 3))
+    hands[:, :, 0] = a[:, None]
+    feet[:, :, 0] = b[:, None]
+    # x of both hands with x of both feet: 4 of the 12 hand-foot-axis pairs at r = 0.8.
+    assert correlation.hand_foot_correlation(hands, feet) == pytest.approx(0.8 * 4 / 12)
+    assert correlation.keeps(hands, feet)
+    # Only left hand x with left foot x: 1 of 12 -> 0.0667 < 0.1, dropped.
+    hands[:, 1, 0] = 0.0
+    feet[:, 1, 0] = 0.0
+    assert correlation.hand_foot_correlation(hands, feet) == pytest.approx(0.8 / 12)
+    assert not correlation.keeps(hands, feet)
+    # Anti-phase coupling counts as much as in-phase coupling.
+    assert correlation.hand_foot_correlation(hands, -feet) == pytest.approx(0.8 / 12)
+
+
+def test_pearson_of_quadrature_signals_is_zero():
+    t = np.arange(360) / 90.0
+    assert correlation.pearson(np.sin(2 * np.pi * t), np.cos(2 * np.pi * t)) == pytest.approx(
+        0.0, abs=1e-9
+    )
+
+
+def test_query_identical_to_database_window_returns_it(small_db):
+    for side in (0, 1):
+        matcher = KNNMatcher(small_db.search[side], k=5, max_distance=0.5)
+        i = small_db.n_windows // 3
+        dist, idx = matcher.query(search_vectors(small_db.windows[[i], :, side]))
+        assert dist[0, 0] == 0.0
+        np.testing.assert_array_equal(
+            small_db.windows[idx[0, 0], :, side], small_db.windows[i, :, side]
+        )
+        assert np.all(np.diff(dist[0][np.isfinite(dist[0])]) >= 0)
+
+
+def test_knn_threshold_drops_far_matches(small_db):
+    matcher = KNNMatcher(small_db.search[0], k=5, max_distance=1e-6)
+    far = small_db.windows[[0], :, 0] + 1.0
+    dist, idx = matcher.query(search_vectors(far))
+    assert np.all(np.isinf(dist)) and np.all(idx == -1)
+
+
+@pytest.mark.parametrize("theta", [0.3, -1.2, 2.9, np.pi / 2])
+def test_alignment_recovers_known_yaw(theta):
+    rng = np.random.default_rng(1)
+    query = rng.normal(scale=0.3, size=(1, 9, 2, 3))
+    # The database copy is the query turned by -theta and shifted sideways: turning it back by
+    # +theta aligns it (the 1/sum c terms make the answer independent of the shift).
+    source = query @ yaw_matrix(-theta).T + np.array([0.2, -0.1, 0.05])
+    got = alignment_yaw(query, source[:, None])
+    assert got[0, 0] == pytest.approx(theta, abs=1e-9)
+
+
+def test_alignment_weights_favour_the_newest_samples():
+    rng = np.random.default_rng(2)
+    query = rng.normal(scale=0.3, size=(1, 9, 2, 3))
+    source = query @ yaw_matrix(-0.5).T
+    source[:, 0] = query[:, 0] @ yaw_matrix(0.4).T  # the oldest sample disagrees...
+    got = alignment_yaw(query, source[:, None])[0, 0]
+    # ...and counts only 1/9 as much as the newest, so the answer stays near 0.5.
+    flat = alignment_yaw(query, source[:, None], side_weights=np.ones((1, 2)))[0, 0]
+    assert abs(got - 0.5) < 0.1 and got == pytest.approx(flat)
+
+
+def test_alignment_ignores_untracked_hand():
+    rng = np.random.default_rng(3)
+    query = rng.normal(scale=0.3, size=(1, 9, 2, 3))
+    source = query @ yaw_matrix(-0.7).T
+    source[:, :, 1] = rng.normal(size=(9, 3))  # right hand garbage in the database window
+    query[:, :, 1] = np.nan  # and untracked in the query
+    got = alignment_yaw(query, source[:, None], side_weights=np.array([[1.0, 0.0]]))
+    assert got[0, 0] == pytest.approx(0.7, abs=1e-9)
+
+
+def test_inverse_distance_weights_by_hand():
+    w = inverse_distance_weights(np.array([[1.0, 2.0, np.inf], [np.inf, np.inf, np.inf]]))
+    np.testing.assert_allclose(w, [[2 / 3, 1 / 3, 0.0], [0.0, 0.0, 0.0]], atol=1e-8)
+    exact = inverse_distance_weights(np.array([[0.0, 0.1, 0.2]]))
+    assert exact[0, 0] > 0.999999
+
+
+def test_group_weights_route_hands_to_their_arms():
+    dl = np.array([[0.1, 0.2]])
+    dr = np.array([[0.3, np.inf]])
+    weights, conf = group_weights(dl, dr, max_distance=0.5)
+    np.testing.assert_allclose(weights[0, 0], [2 / 3, 1 / 3, 0, 0], atol=1e-8)
+    np.testing.assert_allclose(weights[0, 1], [0, 0, 1, 0], atol=1e-8)
+    ql = 2 / 3 * 0.8 + 1 / 3 * 0.6
+    qr = 0.4
+    np.testing.assert_allclose(conf[0], [ql, qr, (ql + qr) / 2])
+    share = ql / (ql + qr)
+    np.testing.assert_allclose(weights[0, 2], [share * 2 / 3, share / 3, 1 - share, 0], atol=1e-8)
+
+
+def test_blending_one_match_reproduces_it():
+    pose = quat.from_scipy(Rotation.random(7, random_state=5))[None, None]  # (1, 1, 7, 4)
+    other = quat.from_scipy(Rotation.random(7, random_state=6))[None, None]
+    weights = np.zeros((1, 7, 2))
+    weights[..., 0] = 1.0
+    out = blend_rotations(np.concatenate([pose, other], axis=1), weights)
+    assert np.allclose(np.abs(np.sum(out[0] * pose[0, 0], axis=-1)), 1.0)
+    # Two matches, equal weights: the midpoint (slerp at 1/2) for nearby rotations.
+    a = quat.from_axis_angle(np.array([0, 0, 1.0]), np.array(0.2))
+    b = quat.from_axis_angle(np.array([0, 0, 1.0]), np.array(-0.6))
+    mid = blend_rotations(np.stack([a, -b])[None, :, None], np.full((1, 1, 2), 0.5))
+    assert quat.yaw(mid[0, 0]) == pytest.approx(-0.2)
+
+
+def test_ewma_weight_one_is_identity_and_zero_holds():
+    prev = quat.from_scipy(Rotation.random(5, random_state=1))
+    cur = quat.from_scipy(Rotation.random(5, random_state=2))
+    np.testing.assert_allclose(np.abs(np.sum(ewma_step(prev, cur, np.ones(5)) * cur, -1)), 1.0)
+    np.testing.assert_allclose(ewma_step(prev, cur, np.zeros(5)), prev)
+    seq = quat.from_scipy(Rotation.random(30, random_state=3), (6, 5))
+    out = ewma(seq, np.ones((6, 5)), prev)
+    np.testing.assert_allclose(np.abs(np.sum(out * seq, -1)), 1.0)
+
+
+def test_ewma_half_weight_is_halfway():
+    a = quat.from_axis_angle(np.array([1.0, 0, 0]), np.array([0.0]))
+    b = quat.from_axis_angle(np.array([1.0, 0, 0]), np.array([0.4]))
+    mid = ewma_step(a, b, np.array([0.5]))
+    assert quat.angle(mid)[0] == pytest.approx(0.2)
+
+
+def test_joint_limits_clamp_knee_and_keep_legal_poses():
+    sk = load_rig("avatar").skeleton
+    limits = JointLimits(sk)
+    rot = np.tile(quat.IDENTITY, (2, sk.n_joints, 1))
+    knee = sk.index("Bip01 L Calf")
+    # Knee flexion is +ry up to 140 degrees: 170 is clipped to 140, 60 is kept.
+    rot[0, knee] = quat.from_axis_angle(np.array([0, 1.0, 0]), np.array(np.radians(170)))
+    rot[1, knee] = quat.from_axis_angle(np.array([0, 1.0, 0]), np.array(np.radians(60)))
+    out = limits.clamp(rot)
+    assert np.degrees(quat.angle(out[0, knee])) == pytest.approx(140.0)
+    np.testing.assert_allclose(out[1], rot[1])
