@@ -2,10 +2,11 @@
 
 ``build_body(skeleton)`` turns any skeleton :func:`avatar_models.rigs.identify_rig` recognises
 into a :class:`BodyDescription`: capsules per bone with de Leva (1996) masses, box or capsule
-feet, a skull sphere, anatomical hinge ranges. From it, ``to_mjcf()`` gives an MJCF string
-(free root, three hinges and position actuators per simulated joint, floor, contacts, body17
-sites), ``qpos_from_motion(motion)`` the exact MuJoCo ``qpos`` of a motion on that skeleton,
-and ``to_trimesh(...)`` the same primitives posed for one frame. MuJoCo is imported only in
+feet split at the ball of the foot (the toes are a joint), a skull sphere, anatomical hinge
+ranges. From it, ``to_mjcf()`` gives an MJCF string (free root, three hinges and position
+actuators per simulated joint, floor, contacts, body17 sites), ``qpos_from_motion(motion)``
+the exact MuJoCo ``qpos`` of a motion on that skeleton, and ``to_trimesh(...)`` the same
+primitives posed for one frame. MuJoCo is imported only in
 :mod:`avatar_models.body.mjcf`.
 """
 

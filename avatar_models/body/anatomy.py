@@ -2,8 +2,9 @@
 
 Works for any skeleton :func:`avatar_models.rigs.identify_rig` recognises, from its ``body17``
 map alone. The simulated joints are the chains from the root to the head, the wrists and the
-ankles; every other joint (fingers, toes, jaw, eyelids, twist bones, end sites) is fixed into
-its nearest simulated ancestor. A joint's role names the anatomical joint it stands for
+ankles, plus the toe joint (body17 ``foot``, the ball of the foot) where it is a child of the
+ankle; every other joint (fingers, toe tips, jaw, eyelids, twist bones, end sites) is fixed
+into its nearest simulated ancestor. A joint's role names the anatomical joint it stands for
 (see :mod:`avatar_models.body.joint_ranges`), a bone's kind names the de Leva segment it
 belongs to (see :mod:`avatar_models.body.anthropometry`).
 """
@@ -30,6 +31,7 @@ _BONE_KIND = {
     "hip": "thigh",
     "knee": "shank",
     "ankle": "foot",
+    "toe": "foot",
     "shoulder": "upper_arm",
     "elbow": "forearm",
     "wrist": "hand",
@@ -94,6 +96,11 @@ def classify(skeleton: Skeleton, rig: Rig) -> Anatomy:
             sides[j] = side
             if limb == "arm":
                 arm_path.add(j)
+        # The ball of the foot bends in gait (heel rise, push-off), so the toes get their own
+        # body when the rig has the toe joint straight below the ankle.
+        if limb == "leg" and skeleton.parents[b[f"{side[0]}_foot"]] == b[f"{side[0]}_ankle"]:
+            roles[b[f"{side[0]}_foot"]] = "toe"
+            sides[b[f"{side[0]}_foot"]] = side
     simulated = np.zeros(skeleton.n_joints, bool)
     simulated[list(roles)] = True
 

@@ -304,7 +304,8 @@ class _Layout:
         heading = float(np.arctan2(toe[1], toe[0])) if np.hypot(toe[0], toe[1]) > 1e-9 else 0.0
         fwd = np.array([np.cos(heading), np.sin(heading), 0.0])
         length = anthro.FOOT_LENGTH_RATIO * height * self.scale.get("foot", 1.0)
-        inside = [j for j in range(self.sk.n_joints) if self.an.body_of[j] == ankle and j != ankle]
+        foot_bodies = (ankle, self.an.body_of[self.an.body17[f"{side}_foot"]])
+        inside = [j for j in range(self.sk.n_joints) if self.an.body_of[j] in foot_bodies]
         rel = self.rest[inside] - self.rest[ankle]
         back = min(-anthro.HEEL_FRACTION * length, float((rel @ fwd).min(initial=0.0)))
         front = max(back + length, float((rel @ fwd).max(initial=0.0)))
@@ -352,6 +353,8 @@ class _Layout:
         out = []
         for c in np.flatnonzero(self.an.simulated)[1:]:
             kind, side, bone = self.an.bone_kind[c], self.an.sides[c], self.sk.offsets[c]
+            if kind == "foot":  # the foot is its boxes (ankle to toe joint), see _feet
+                continue
             length = float(np.linalg.norm(bone))
             if length < 1e-9:
                 continue
@@ -402,47 +405,75 @@ class _Layout:
         return out
 
     def _feet(self, shape: str) -> list[Segment]:
-        """A box (or a capsule) from heel to toe tip under each ankle, its top at the ankle,
-        its CoM at de Leva's fraction from the heel."""
+        """Per side a box (or a capsule) from heel to toe tip, top at the ankle, split at the
+        ball of the foot when the toes have their own body: the hindfoot piece under the
+        ankle, the toe piece under the toe joint, sharing one sole. de Leva's foot mass is
+        spread at uniform density (:meth:`segments`), i.e. by length for boxes; the CoM of
+        the whole foot stays at de Leva's fraction from the heel (:meth:`_foot_pieces`)."""
         out = []
         for s, side in (("l", "left"), ("r", "right")):
-            ankle = self.an.body17[f"{s}_ankle"]
+            ankle, toe = self.an.body17[f"{s}_ankle"], self.an.body17[f"{s}_foot"]
             f = self.feet[s]
             fwd = np.array([np.cos(f.heading), np.sin(f.heading), 0.0])
-            mid_z = np.array([0.0, 0.0, 0.5 * (f.bottom + f.top)])
-            half = np.array(
-                [0.5 * (f.front - f.back), self.radius("foot"), 0.5 * (f.top - f.bottom)]
-            )
-            heel, tip = f.back * fwd + mid_z, f.front * fwd + mid_z
-            common = dict(
-                name=f"foot:{self.sk.names[ankle]}",
-                kind="foot",
-                side=side,
-                body=ankle,
-                mass=0.0,
-                com=heel + anthro.SEGMENTS["foot"].com * (tip - heel),
-            )
-            if shape == "box":
-                centre = 0.5 * (heel + tip)
-                out.append(
-                    Segment(
+            r = 0.5 * (f.top - f.bottom)
+            breaks = [f.back, f.front]
+            bodies = [ankle]
+            if self.an.simulated[toe]:
+                breaks.insert(1, float(self.sk.offsets[toe] @ fwd))
+                bodies.append(toe)
+            pieces = []
+            for body, back, front in zip(bodies, breaks[:-1], breaks[1:], strict=True):
+                origin = self.rest[body] - self.rest[ankle]
+                mid_z = np.array([0.0, 0.0, f.bottom + r]) - origin
+                heel, tip = back * fwd + mid_z, front * fwd + mid_z
+                common = dict(
+                    name=f"foot:{self.sk.names[body]}", kind="foot", side=side, body=body, mass=0.0
+                )
+                if shape == "box":
+                    centre = 0.5 * (heel + tip)
+                    half = np.array([0.5 * (front - back), self.radius("foot"), r])
+                    piece = Segment(
                         shape="box",
                         start=centre,
                         end=centre,
                         radius=float(half.min()),
                         half_extents=half,
                         heading=f.heading,
+                        com=centre,
                         **common,
                     )
-                )
-            else:
-                r = half[2]
-                out.append(
-                    Segment(
-                        shape="capsule", start=heel + r * fwd, end=tip - r * fwd, radius=r, **common
+                else:  # round ends at the heel and the toe tip only
+                    start = heel + r * fwd if back == f.back else heel
+                    end = tip - r * fwd if front == f.front else tip
+                    piece = Segment(
+                        shape="capsule",
+                        start=start,
+                        end=end,
+                        radius=r,
+                        com=0.5 * (start + end),
+                        **common,
                     )
-                )
+                pieces.append(piece)
+            out.extend(self._with_foot_com(pieces, f.back * fwd, f.front * fwd, ankle))
         return out
+
+    def _with_foot_com(
+        self, pieces: list[Segment], heel: np.ndarray, tip: np.ndarray, ankle: int
+    ) -> list[Segment]:
+        """Set the CoM of the first (hindfoot) piece so that the foot's CoM lies at de Leva's
+        fraction from heel to toe tip (ankle frame, horizontal), the others at their centres.
+        Masses follow volumes, as in :meth:`segments`."""
+        volumes = np.array([p.volume() for p in pieces])
+        weights = volumes / volumes.sum()
+        origins = [self.rest[p.body] - self.rest[ankle] for p in pieces]
+        target = heel + anthro.SEGMENTS["foot"].com * (tip - heel)
+        target[2] = pieces[0].com[2]
+        rest_of = sum(
+            (w * (p.com + o) for w, p, o in zip(weights[1:], pieces[1:], origins[1:], strict=True)),
+            np.zeros(3),
+        )
+        hind = (target - rest_of) / weights[0]
+        return [replace(pieces[0], com=hind)] + pieces[1:]
 
     def _skull(self) -> Segment:
         """The skull sphere, its top at the head's extent along the neck direction."""

@@ -4,8 +4,9 @@ Axes are the joint's local axes, which in the rest pose are the world axes (the 
 faces +X, left is +Y, Z is up; rest local rotations are the identity). For a LEFT limb:
 
 - about Y (the sagittal axis of rotation): +Y bends a downward bone backwards, an upward
-  bone forwards: hip flexion is -ry, knee flexion +ry, ankle plantarflexion +ry, spine and
-  neck flexion +ry;
+  bone forwards, a forward bone downwards: hip flexion is -ry, knee flexion +ry, ankle
+  plantarflexion +ry, toe flexion +ry (toe extension, the toes bent up at push-off, -ry),
+  spine and neck flexion +ry;
 - about X: +rx moves a downward leg outwards (abduction), a sideways (+Y) arm upwards, and
   everts the foot;
 - about Z: +rz turns a forward-pointing foot outwards and swings a sideways arm backwards.
@@ -17,7 +18,8 @@ Degrees are the AAOS average ranges of motion (Greene & Heckman 1994, *The Clini
 Measurement of Joint Motion*, AAOS; the same values as AAOS 1965, *Joint Motion: Method of
 Measuring and Recording*): hip flexion 120 / extension 30 / abduction 45 / adduction 30 /
 internal and external rotation 45; knee flexion 135 (+10 hyperextension); ankle
-plantarflexion 50, inversion 35 / eversion 15; shoulder abduction 180 /
+plantarflexion 50, inversion 35 / eversion 15; first metatarsophalangeal (toe) flexion 45 /
+extension 70; shoulder abduction 180 /
 adduction 30, horizontal flexion 135 / extension 45, internal rotation 70 / external 90;
 elbow flexion 150, pronation and supination 80; wrist flexion 80 / extension 70, radial
 deviation 20 / ulnar 30; thoracolumbar spine flexion 80 / extension 25 / lateral bending 35 /
@@ -31,9 +33,9 @@ horizontal (T-pose), so rx = abduction - 90. Elbow flexion is about Z because th
 has the palms down.
 
 Degrees of freedom a joint does not have anatomically (knee and elbow varus/valgus, wrist
-axial rotation, the pelvic girdle) get a small allowance so the hinge still exists for
-exact kinematic replay; joints between the skeleton root and the pelvis are part of the
-free root and get the full circle.
+axial rotation, the pelvic girdle, toe abduction and axial rotation) get a small allowance so
+the hinge still exists for exact kinematic replay; joints between the skeleton root and the
+pelvis are part of the free root and get the full circle.
 
 The spine and the neck are chains of several joints in most rigs; their ranges are the whole
 chain's, and :func:`joint_ranges` divides them evenly over the chain's joints.
@@ -52,6 +54,7 @@ ROLE_TABLE: dict[str, tuple[str, dict[str, tuple[float, float]], bool]] = {
     "hip": ("YXZ", {"x": (-30, 45), "y": (-120, 30), "z": (-45, 45)}, False),
     "knee": ("YXZ", {"x": (-5, 5), "y": (-10, 135), "z": (-30, 40)}, False),
     "ankle": ("YXZ", {"x": (-35, 15), "y": (-40, 50), "z": (-20, 10)}, False),
+    "toe": ("YXZ", {"x": (-5, 5), "y": (-70, 45), "z": (-5, 5)}, False),
     "shoulder_girdle": ("XZY", {"x": (-10, 45), "y": (-30, 30), "z": (-15, 30)}, True),
     "shoulder": ("XZY", {"x": (-120, 90), "y": (-90, 70), "z": (-135, 45)}, False),
     "elbow": ("ZXY", {"x": (-5, 5), "y": (-80, 80), "z": (-150, 10)}, True),

@@ -10,8 +10,9 @@ anatomical range and a position actuator.
 Actuator gains: ``kp = 4 g m H / 2``, i.e. a load of mass ``m`` at half the stature ``H``
 (about the height of the body's centre of mass) deflects the joint by at most a quarter
 radian under gravity. ``m`` is what the joint carries when standing: the whole body for leg
-joints, the subtree below the joint otherwise. ``kv = kp * 0.05 s`` (a 50 ms time constant),
-integrated implicitly (``implicitfast``) so light distal segments stay stable.
+joints (the toes too: the body rolls over them at push-off), the subtree below the joint
+otherwise. ``kv = kp * 0.05 s`` (a 50 ms time constant), integrated implicitly
+(``implicitfast``) so light distal segments stay stable.
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ DAMPING_TIME_S = 0.05
 TIMESTEP_S = 0.002
 ARMATURE = 0.02
 PLACEHOLDER_MASS_KG = 1e-4
-LEG_ROLES = ("pelvic_girdle", "hip", "knee", "ankle")
+LEG_ROLES = ("pelvic_girdle", "hip", "knee", "ankle", "toe")
 AXIS_VECTORS = {"x": "1 0 0", "y": "0 1 0", "z": "0 0 1"}
 SEGMENT_RGBA = "0.8 0.6 0.45 1"
 
@@ -174,8 +175,9 @@ def _add_inertial_and_geoms(desc: BodyDescription, j: int, body: ET.Element) -> 
 
 
 def _adjacent_bodies(desc: BodyDescription, xml: str) -> list[tuple[str, str]]:
-    """Body pairs that must not collide: parent and child, and pairs whose geoms already
-    touch in the rest pose (thighs at the crotch, bodies joined by zero-length bones)."""
+    """Body pairs that must not collide: parent and child (ankle and toes included), and pairs
+    whose geoms already touch in the rest pose (thighs at the crotch, bodies joined by
+    zero-length bones)."""
     sk = desc.skeleton
     pairs = {(sk.names[int(sk.parents[j])], sk.names[int(j)]) for j in desc.simulated_joints[1:]}
     model = mujoco.MjModel.from_xml_string(xml)

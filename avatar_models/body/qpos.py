@@ -3,7 +3,7 @@
 qpos = root position (3), root quaternion wxyz (4), then per simulated joint in body order
 its hinge angles: the intrinsic Euler angles of the joint's local rotation in the order its
 hinges are declared (``R = R_a R_b R_c``). Angles are unwrapped over time, so a joint turning
-past +-pi keeps a continuous trajectory. Fixed joints (fingers, toes, jaw...) are dropped.
+past +-pi keeps a continuous trajectory. Fixed joints (fingers, toe tips, jaw...) are dropped.
 """
 
 from __future__ import annotations
