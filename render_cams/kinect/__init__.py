@@ -1,0 +1,34 @@
+"""Simulated Kinect V2 and Azure Kinect: depth with a published noise model, body-index maps
+and 30 Hz skeleton streams (issue 4, item 6).
+
+- :mod:`.sensors`: depth modes (size, field of view, range) with sources.
+- :mod:`.noise`: axial/lateral depth noise, flying pixels, invalid pixels.
+- :mod:`.depth`: depth frames and body-index maps rendered from a ``BodyScene``; PNG writers.
+- :mod:`.skeleton`: joints on the kinect_v2 / azure_kinect rigs, tracking state, noise.
+- :mod:`.sequence`: a whole recording on disk (depth, body index, skeleton JSON, preview).
+"""
+
+from render_cams.kinect.noise import DepthNoiseModel
+from render_cams.kinect.placement import KinectPlacementError, default_sensor_pose, look_at
+from render_cams.kinect.sensors import SENSORS, DepthSensor, KinectError, get_sensor
+from render_cams.kinect.skeleton import (
+    KinectSkeletonStream,
+    SkeletonNoise,
+    TrackingState,
+    kinect_skeleton,
+)
+
+__all__ = [
+    "SENSORS",
+    "DepthNoiseModel",
+    "DepthSensor",
+    "KinectError",
+    "KinectPlacementError",
+    "KinectSkeletonStream",
+    "SkeletonNoise",
+    "TrackingState",
+    "default_sensor_pose",
+    "get_sensor",
+    "kinect_skeleton",
+    "look_at",
+]

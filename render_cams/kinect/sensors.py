@@ -1,0 +1,115 @@
+"""Depth sensor specifications of the Kinect V2 and the Azure Kinect depth camera.
+
+Sources:
+- Kinect for Windows v2: depth 512 x 424, 70.6 deg x 60 deg field of view, 0.5-4.5 m, 30 fps
+  (Microsoft Kinect for Windows v2 product specification; Fankhauser et al. 2015, Table I).
+- Azure Kinect DK hardware specification (Microsoft docs, "Azure Kinect DK hardware
+  specifications", depth camera modes table): NFOV unbinned 640 x 576, 75 x 65 deg,
+  0.5-3.86 m; WFOV 2x2 binned 512 x 512, 120 x 120 deg, 0.25-2.88 m; WFOV unbinned
+  1024 x 1024, 120 x 120 deg, 0.25-2.21 m (15 fps in the real device; simulated at 30 Hz
+  with the others so every stream shares the skeleton rate).
+
+Every mode is modelled as an ideal pinhole with square pixels and the principal point at the
+image centre (the real lenses' distortion is calibrated away by the SDKs' point clouds). The
+horizontal field of view sets the focal length; the vertical one then follows from the aspect
+ratio (58.5 deg for V2's 70.6 deg, 63.0 deg for NFOV's 75 deg: within 2 deg of the quoted
+values, which are rounded and measured on distorted lenses).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from render_cams.device import DeviceError
+from render_cams.kinect.noise import AZURE_KINECT_NOISE, KINECT_V2_NOISE, DepthNoiseModel
+from render_cams.scene import pinhole_K
+from render_cams.tracking import UnknownDeviceError
+
+KINECT_RATE_HZ = 30.0
+
+
+class KinectError(DeviceError):
+    """A Kinect simulation configured with impossible values (range, pose, device)."""
+
+
+@dataclass(frozen=True)
+class DepthSensor:
+    """One depth camera mode.
+
+    Attributes:
+        name: device name as the CLI spells it (``"kinect-v2"``, ``"azure-kinect"``...).
+        width, height: depth image size in pixels.
+        fov_deg: ``(horizontal, vertical)`` field of view quoted by the maker, degrees.
+        range_m: ``(near, far)`` operating range; depth outside it is reported as 0.
+        rig: skeleton rig of its body tracker (``"kinect_v2"`` or ``"azure_kinect"``).
+        noise: the depth noise model.
+        rate_hz: frame rate of depth and skeleton streams.
+    """
+
+    name: str
+    width: int
+    height: int
+    fov_deg: tuple[float, float]
+    range_m: tuple[float, float]
+    rig: str
+    noise: DepthNoiseModel
+    rate_hz: float = KINECT_RATE_HZ
+
+    def __post_init__(self) -> None:
+        near, far = (float(x) for x in self.range_m)
+        if not (np.isfinite(near) and np.isfinite(far) and 0.0 < near < far):
+            raise KinectError(
+                f"{self.name}: depth range must satisfy 0 < near < far, got {self.range_m!r}"
+            )
+        if self.width < 1 or self.height < 1:
+            raise KinectError(f"{self.name}: image size must be positive")
+        h_fov = float(self.fov_deg[0])
+        if not 0.0 < h_fov < 180.0:
+            raise KinectError(f"{self.name}: horizontal field of view must be in (0, 180) deg")
+        object.__setattr__(self, "range_m", (near, far))
+
+    @property
+    def K(self) -> np.ndarray:
+        """``(3, 3)`` pinhole intrinsics (OpenCV conventions)."""
+        return pinhole_K(np.radians(self.fov_deg[0]), self.width, self.height)
+
+
+SENSORS: dict[str, DepthSensor] = {
+    s.name: s
+    for s in (
+        DepthSensor("kinect-v2", 512, 424, (70.6, 60.0), (0.5, 4.5), "kinect_v2", KINECT_V2_NOISE),
+        DepthSensor(
+            "azure-kinect", 640, 576, (75.0, 65.0), (0.5, 3.86), "azure_kinect", AZURE_KINECT_NOISE
+        ),
+        DepthSensor(
+            "azure-kinect-wfov-binned",
+            512,
+            512,
+            (120.0, 120.0),
+            (0.25, 2.88),
+            "azure_kinect",
+            AZURE_KINECT_NOISE,
+        ),
+        DepthSensor(
+            "azure-kinect-wfov",
+            1024,
+            1024,
+            (120.0, 120.0),
+            (0.25, 2.21),
+            "azure_kinect",
+            AZURE_KINECT_NOISE,
+        ),
+    )
+}
+"""Known modes; ``"azure-kinect"`` is the NFOV unbinned mode, the SDK's default for tracking."""
+
+
+def get_sensor(device: str | DepthSensor) -> DepthSensor:
+    """The sensor named ``device`` (or ``device`` itself); :class:`UnknownDeviceError` if none."""
+    if isinstance(device, DepthSensor):
+        return device
+    if device not in SENSORS:
+        raise UnknownDeviceError(str(device), tuple(SENSORS))
+    return SENSORS[device]
