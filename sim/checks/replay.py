@@ -1,0 +1,148 @@
+"""``BodyReplay``: a motion replayed on its humanoid, with the quantities several checks share.
+
+Shapes: ``T`` frames, feet ordered (left, right), sole points per foot ordered (heel, toe),
+sole corners per foot (heel-left, heel-right, toe-left, toe-right). Sole points lie on the
+bottom face of each foot primitive (box or capsule) of :class:`avatar_models.body.Segment`,
+moved with MuJoCo's body frames, so contacts follow the simulated geometry, not joints.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import mujoco
+import numpy as np
+
+from avatar_models.body import BodyDescription, Segment
+from sim.replay import ReplayTrace, replay_kinematic
+from sim.thresholds import CheckConfig
+
+SIDES = ("left", "right")
+
+
+def _sole_points(seg: Segment) -> np.ndarray:
+    """``(6, 3)`` heel, toe, then four sole corners of a foot primitive, in its body frame."""
+    if seg.shape == "box":
+        hx, hy, hz = seg.half_extents
+        local = np.array(
+            [
+                [-hx, 0, -hz],
+                [hx, 0, -hz],
+                [-hx, hy, -hz],
+                [-hx, -hy, -hz],
+                [hx, hy, -hz],
+                [hx, -hy, -hz],
+            ]
+        )
+        return seg.start + local @ seg.box_rotation.T
+    axis = seg.end - seg.start
+    lateral = np.cross([0.0, 0.0, 1.0], axis)
+    lateral *= seg.radius / max(np.linalg.norm(lateral), 1e-12)
+    down = np.array([0.0, 0.0, -seg.radius])
+    heel, toe = seg.start + down, seg.end + down
+    return np.stack([heel, toe, heel + lateral, heel - lateral, toe + lateral, toe - lateral])
+
+
+def finite_speed(x: np.ndarray, fps: float) -> np.ndarray:
+    """``(T, ...)`` time derivative by central differences (one-sided at the ends)."""
+    if x.shape[0] < 2:
+        return np.zeros_like(x)
+    return np.gradient(x, 1.0 / fps, axis=0)
+
+
+@dataclass(frozen=True, eq=False)
+class BodyReplay:
+    """A motion's qpos replayed kinematically on the body's MuJoCo model.
+
+    Attributes:
+        body: the body description.
+        model: its compiled MuJoCo model.
+        qpos: ``(T, nq)``.
+        fps: frames per second.
+        trace: the MuJoCo replay (:class:`~sim.replay.ReplayTrace`).
+        config: definitions and thresholds.
+    """
+
+    body: BodyDescription
+    model: mujoco.MjModel
+    qpos: np.ndarray
+    fps: float
+    trace: ReplayTrace
+    config: CheckConfig
+
+    @classmethod
+    def run(
+        cls,
+        body: BodyDescription,
+        model: mujoco.MjModel,
+        qpos: np.ndarray,
+        fps: float,
+        config: CheckConfig,
+    ) -> BodyReplay:
+        return cls(body, model, qpos, fps, replay_kinematic(model, qpos), config)
+
+    @property
+    def n_frames(self) -> int:
+        return self.qpos.shape[0]
+
+    @cached_property
+    def foot_bodies(self) -> np.ndarray:
+        """``(2,)`` MuJoCo body ids carrying the left and right foot primitives."""
+        return np.array([self.model.body(self.body.skeleton.names[s.body]).id for s in self._feet])
+
+    @cached_property
+    def _feet(self) -> tuple[Segment, Segment]:
+        feet = {s.side: s for s in self.body.segments if s.kind == "foot"}
+        return feet["left"], feet["right"]
+
+    @cached_property
+    def _sole_world(self) -> np.ndarray:
+        """``(T, 2, 6, 3)`` heel, toe and corners of both soles in the world."""
+        local = np.stack([_sole_points(s) for s in self._feet])  # (2, 6, 3)
+        pos = self.trace.body_pos[:, self.foot_bodies]  # (T, 2, 3)
+        rot = self.trace.body_rot[:, self.foot_bodies]  # (T, 2, 3, 3)
+        return pos[:, :, None] + np.einsum("tfij,fpj->tfpi", rot, local)
+
+    @property
+    def sole_points(self) -> np.ndarray:
+        """``(T, 2, 2, 3)`` heel and toe of each sole."""
+        return self._sole_world[:, :, :2]
+
+    @property
+    def sole_corners(self) -> np.ndarray:
+        """``(T, 2, 4, 3)`` the four corners of each sole."""
+        return self._sole_world[:, :, 2:]
+
+    @cached_property
+    def sole_velocity(self) -> np.ndarray:
+        """``(T, 2, 2, 3)`` velocity of heel and toe of each sole (m/s)."""
+        return finite_speed(self.sole_points, self.fps)
+
+    @cached_property
+    def point_contact(self) -> np.ndarray:
+        """``(T, 2, 2)`` heel/toe of each foot in contact: low AND not moving vertically."""
+        c = self.config
+        low = self.sole_points[..., 2] < c.contact_height_m
+        still = np.abs(self.sole_velocity[..., 2]) < c.contact_vz_m_s
+        return low & still
+
+    @property
+    def foot_contact(self) -> np.ndarray:
+        """``(T, 2)`` left/right foot in contact (heel or toe)."""
+        return self.point_contact.any(axis=2)
+
+    @cached_property
+    def supported(self) -> np.ndarray:
+        """``(T,)`` some body geom is within the contact height of the floor."""
+        return self.trace.lowest_point < self.config.contact_height_m
+
+    @cached_property
+    def com(self) -> np.ndarray:
+        """``(T, 3)`` whole-body centre of mass."""
+        return self.trace.com(self.model)
+
+    @cached_property
+    def hinge_names(self) -> list[str]:
+        """Names of the hinges in qpos order (after the free root's 7 numbers)."""
+        return [self.model.joint(j).name for j in range(1, self.model.njnt)]
