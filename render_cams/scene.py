@@ -21,11 +21,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import avatar_models  # noqa: F401  (picks the OpenGL backend before pyrender loads)
 import numpy as np
 import pyrender
 import trimesh
 
+import avatar_models  # noqa: F401  (picks the OpenGL backend before pyrender loads)
 from avatar_models import AvatarsimError, Motion, quat
 from avatar_models.body import BodyDescription, build_body
 from avatar_models.body.mesh import mesh_template

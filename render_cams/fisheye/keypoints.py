@@ -1,0 +1,123 @@
+"""``body17`` 2D keypoints of a fisheye camera: projection, visibility, confidence, noise.
+
+Projection uses the camera's own model (:meth:`FisheyeModel.project`, equal to
+``cv2.fisheye.projectPoints``), vectorised over frames and joints. A joint is *visible* when it
+projects inside the image and the rendered range at its pixel is not shorter than the joint's
+range minus the body's thickness there (a joint sits inside its limb, so the visible surface
+is up to one limb radius nearer): otherwise something else, usually the user's own arm or
+body, is in front of it.
+
+Confidence is a heuristic of what a 2D detector reports (ControllerPose §4.3 feeds OpenPose
+confidences to its network): 1 at the image centre falling to 0.5 at the 90 deg image
+circle, where the lens compresses the body most, and 0.1 for occluded joints.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from avatar_models.body import BodyDescription
+from render_cams.device import DeviceError
+from render_cams.fisheye.model import HALF_PI, FisheyeModel
+
+OCCLUDED_CONFIDENCE = 0.1
+RIM_CONFIDENCE = 0.5
+DEPTH_SLACK_M = 0.03  # rasterisation and tessellation error of the rendered range
+
+
+def world_to_camera(camera_to_world: np.ndarray) -> np.ndarray:
+    """``(..., 4, 4)`` inverse of rigid poses ``(..., 4, 4)``."""
+    rot = camera_to_world[..., :3, :3]
+    out = np.zeros_like(camera_to_world)
+    out[..., :3, :3] = np.swapaxes(rot, -1, -2)
+    out[..., :3, 3] = -np.einsum("...ba,...b->...a", rot, camera_to_world[..., :3, 3])
+    out[..., 3, 3] = 1.0
+    return out
+
+
+def project_joints(
+    model: FisheyeModel, camera_to_world: np.ndarray, joints: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Pixels ``(T, J, 2)``, in-image mask ``(T, J)`` and range ``(T, J)`` (metres) of world
+    joints ``(T, J, 3)`` seen by cameras at ``camera_to_world`` ``(T, 4, 4)``."""
+    w2c = world_to_camera(np.asarray(camera_to_world, float))
+    cam = np.einsum("tab,tjb->tja", w2c[:, :3, :3], joints) + w2c[:, None, :3, 3]
+    uv, in_image = model.project(cam)
+    return uv, in_image, np.linalg.norm(cam, axis=-1)
+
+
+def joint_thickness(body: BodyDescription) -> np.ndarray:
+    """``(17,)`` the largest radius of the segments carried by or ending at each body17 joint:
+    how far in front of a joint its own body surface can be."""
+    joints = body.rig.body17_indices(body.skeleton)
+    parents = body.skeleton.parents
+    out = np.zeros(len(joints))
+    for k, j in enumerate(joints):
+        radii = [s.radius for s in body.segments if s.body == j or s.body == parents[j]]
+        out[k] = max(radii, default=0.05)
+    return out
+
+
+def visibility(
+    uv: np.ndarray,
+    in_image: np.ndarray,
+    joint_range: np.ndarray,
+    range_image: np.ndarray,
+    thickness: np.ndarray,
+) -> np.ndarray:
+    """``(J,)`` bool: joints of one frame not hidden behind other surfaces.
+
+    Args:
+        uv, in_image, joint_range: one frame of :func:`project_joints` (``(J, 2)``, ``(J,)``).
+        range_image: ``(H, W)`` rendered range (0 where nothing was hit).
+        thickness: ``(J,)`` from :func:`joint_thickness`.
+    """
+    h, w = range_image.shape
+    col = np.clip(np.rint(uv[:, 0]).astype(int), 0, w - 1)
+    row = np.clip(np.rint(uv[:, 1]).astype(int), 0, h - 1)
+    seen = range_image[row, col]
+    nearest_allowed = joint_range - thickness - DEPTH_SLACK_M
+    return in_image & ((seen == 0) | (seen >= nearest_allowed))
+
+
+def confidence(model: FisheyeModel, uv: np.ndarray, visible: np.ndarray) -> np.ndarray:
+    """``(...)`` detector-like confidence of keypoints ``uv`` ``(..., 2)`` (module docstring)."""
+    theta = np.nan_to_num(model.angle_of_pixels(uv), nan=HALF_PI)
+    rim = 1.0 - (1.0 - RIM_CONFIDENCE) * (theta / HALF_PI) ** 2
+    return np.where(visible, rim, OCCLUDED_CONFIDENCE)
+
+
+@dataclass(frozen=True)
+class DetectorNoise:
+    """Errors of a 2D pose detector, as assumptions (no published model for fisheye views):
+    Gaussian pixel error, larger for occluded joints (the detector guesses them), and misses.
+
+    Attributes:
+        sigma_px: pixel error of visible joints.
+        occluded_sigma_px: pixel error of occluded joints.
+        miss_rate: probability a visible joint is not reported.
+        occluded_miss_rate: probability an occluded joint is not reported.
+    """
+
+    sigma_px: float = 2.0
+    occluded_sigma_px: float = 12.0
+    miss_rate: float = 0.02
+    occluded_miss_rate: float = 0.5
+
+    def __post_init__(self) -> None:
+        values = (self.sigma_px, self.occluded_sigma_px, self.miss_rate, self.occluded_miss_rate)
+        if not all(np.isfinite(v) and v >= 0 for v in values) or max(values[2:]) > 1:
+            raise DeviceError(f"detector noise needs sigmas >= 0 and rates in [0, 1]: {self}")
+
+    def apply(
+        self, uv: np.ndarray, visible: np.ndarray, conf: np.ndarray, rng: np.random.Generator
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Noisy ``uv`` ``(..., 2)``, ``detected`` mask and confidence (0 where missed)."""
+        sigma = np.where(visible, self.sigma_px, self.occluded_sigma_px)[..., None]
+        noisy = uv + rng.normal(size=uv.shape) * sigma
+        miss = rng.random(visible.shape) < np.where(
+            visible, self.miss_rate, self.occluded_miss_rate
+        )
+        return noisy, ~miss, np.where(miss, 0.0, conf)
