@@ -296,9 +296,11 @@ class _Layout:
 
     def _foot_frame(self, side: str, height: float) -> _FootFrame:
         """Where the foot of ``side`` (``"l"``/``"r"``) lies in its ankle frame: pointing at
-        the toe joint, ANSUR foot length with a quarter behind the ankle (or back to a heel
-        joint), top at the ankle, sole at the lowest foot joint but at least half a foot
-        breadth below the ankle."""
+        the toe joint; back to the rig's heel joint where it has one (the walk generator rolls
+        the foot about it, so no sole may reach behind it), else a quarter of the ANSUR foot
+        length behind the ankle; ANSUR foot length long, or up to the toe tip; top at the
+        ankle, sole at the lowest foot joint but at least half a foot breadth below the
+        ankle."""
         ankle = self.an.body17[f"{side}_ankle"]
         toe = self.rest[self.an.body17[f"{side}_foot"]] - self.rest[ankle]
         heading = float(np.arctan2(toe[1], toe[0])) if np.hypot(toe[0], toe[1]) > 1e-9 else 0.0
@@ -307,7 +309,8 @@ class _Layout:
         foot_bodies = (ankle, self.an.body_of[self.an.body17[f"{side}_foot"]])
         inside = [j for j in range(self.sk.n_joints) if self.an.body_of[j] in foot_bodies]
         rel = self.rest[inside] - self.rest[ankle]
-        back = min(-anthro.HEEL_FRACTION * length, float((rel @ fwd).min(initial=0.0)))
+        heel = float((rel @ fwd).min(initial=0.0))
+        back = heel if heel < 0.0 else -anthro.HEEL_FRACTION * length
         front = max(back + length, float((rel @ fwd).max(initial=0.0)))
         half_width = anthro.SEGMENTS["foot"].radius_ratio * height
         bottom = min(float(rel[:, 2].min(initial=0.0)), -half_width)
@@ -409,7 +412,7 @@ class _Layout:
         ball of the foot when the toes have their own body: the hindfoot piece under the
         ankle, the toe piece under the toe joint, sharing one sole. de Leva's foot mass is
         spread at uniform density (:meth:`segments`), i.e. by length for boxes; the CoM of
-        the whole foot stays at de Leva's fraction from the heel (:meth:`_foot_pieces`)."""
+        the whole foot stays at de Leva's fraction from the heel (:meth:`_with_foot_com`)."""
         out = []
         for s, side in (("l", "left"), ("r", "right")):
             ankle, toe = self.an.body17[f"{s}_ankle"], self.an.body17[f"{s}_foot"]
@@ -425,12 +428,12 @@ class _Layout:
             for body, back, front in zip(bodies, breaks[:-1], breaks[1:], strict=True):
                 origin = self.rest[body] - self.rest[ankle]
                 mid_z = np.array([0.0, 0.0, f.bottom + r]) - origin
-                heel, tip = back * fwd + mid_z, front * fwd + mid_z
+                rear, fore = back * fwd + mid_z, front * fwd + mid_z
                 common = dict(
                     name=f"foot:{self.sk.names[body]}", kind="foot", side=side, body=body, mass=0.0
                 )
                 if shape == "box":
-                    centre = 0.5 * (heel + tip)
+                    centre = 0.5 * (rear + fore)
                     half = np.array([0.5 * (front - back), self.radius("foot"), r])
                     piece = Segment(
                         shape="box",
@@ -442,9 +445,11 @@ class _Layout:
                         com=centre,
                         **common,
                     )
-                else:  # round ends at the heel and the toe tip only
-                    start = heel + r * fwd if back == f.back else heel
-                    end = tip - r * fwd if front == f.front else tip
+                else:
+                    # The heel cap is centred over the heel, so the sole reaches the heel (the
+                    # foot rolls about it); the toe cap ends at the toe tip.
+                    start = rear
+                    end = fore - r * fwd if front == f.front else fore
                     piece = Segment(
                         shape="capsule",
                         start=start,
