@@ -41,16 +41,24 @@ def hand_confidence(dist: np.ndarray, weights: np.ndarray, max_distance: float) 
 
 
 def group_weights(
-    dist_left: np.ndarray, dist_right: np.ndarray, max_distance: float
+    dist_left: np.ndarray,
+    dist_right: np.ndarray,
+    max_distance: float,
+    weights_left: np.ndarray | None = None,
+    weights_right: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Match weights per joint group and each group's confidence.
+
+    Per-hand match weights default to :func:`inverse_distance_weights` of the distances (the
+    mixture variant brings its own).
 
     Returns:
         weights ``(B, 3, M)``: rows for the left limb, the right limb and the rest; each row
         sums to 1 or is all 0 (no match for that group).
         confidence ``(B, 3)`` in [0, 1] for the same groups.
     """
-    wl, wr = inverse_distance_weights(dist_left), inverse_distance_weights(dist_right)
+    wl = inverse_distance_weights(dist_left) if weights_left is None else weights_left
+    wr = inverse_distance_weights(dist_right) if weights_right is None else weights_right
     ql = hand_confidence(dist_left, wl, max_distance)
     qr = hand_confidence(dist_right, wr, max_distance)
     zl, zr = np.zeros_like(wl), np.zeros_like(wr)

@@ -13,6 +13,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from synthesis.coolmoves.blend import inverse_distance_weights
+
 K_NEIGHBOURS = 5
 """Matches per hand, as in the paper's Fig. 3 ("top 5 matches")."""
 MAX_DISTANCE = 0.6
@@ -33,14 +35,15 @@ class KNNMatcher:
         self.max_distance = float(max_distance)
         self.tree = cKDTree(np.asarray(vectors, float))
 
-    def query(self, queries: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Distances and indices ``(B, k)`` for ``queries (B, F)``, nearest first.
+    def query(self, queries: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Distances, indices and blend weights ``(B, k)`` for ``queries (B, F)``, nearest
+        first; weights are inversely proportional to distance (§3.1.4).
 
-        Matches beyond the threshold have distance ``inf`` and index ``-1``.
+        Matches beyond the threshold have distance ``inf``, index ``-1`` and weight 0.
         """
         dist, idx = self.tree.query(
             queries, k=self.k, distance_upper_bound=self.max_distance, workers=1
         )
         dist = np.asarray(dist, float).reshape(len(queries), self.k)
         idx = np.asarray(idx).reshape(len(queries), self.k)
-        return dist, np.where(np.isfinite(dist), idx, -1)
+        return dist, np.where(np.isfinite(dist), idx, -1), inverse_distance_weights(dist)

@@ -7,6 +7,12 @@ into intrinsic Euler angles in the order of its anatomical role
 (:mod:`avatar_models.body.joint_ranges`: e.g. ``YXZ`` for legs and spine, so that flexion
 comes first), each angle is clipped to its range, and the rotation rebuilt. Joints without a
 recognised role use ``XYZ``.
+
+Stylised databases go beyond textbook ranges (a boxer's guard, a swimmer's stroke), and near
+an Euler singularity a small pose change swings the angles widely: clipping those would
+distort the very poses the database holds. Given the database poses (``widen_to``), each
+range is therefore widened to include every angle they reach, so that only blends leaving
+both the anatomical and the recorded range are thresholded.
 """
 
 from __future__ import annotations
@@ -25,7 +31,8 @@ _DEFAULT_ORDER = "XYZ"
 class JointLimits:
     """Clamp local rotations to a skeleton's joint limits, vectorised per Euler order."""
 
-    def __init__(self, skeleton: Skeleton):
+    def __init__(self, skeleton: Skeleton, widen_to: np.ndarray | None = None):
+        """``widen_to``: optional ``(P, J, 4)`` poses whose angles every range must include."""
         try:
             rig = identify_rig(skeleton)
             roles = classify(skeleton, rig).roles
@@ -48,15 +55,18 @@ class JointLimits:
                     for j in joints
                 ]
             )  # (G, 3 axes, lo/hi)
-            self.groups.append((order, np.array(joints), bounds[..., 0], bounds[..., 1]))
+            lo, hi = bounds[..., 0], bounds[..., 1]
+            if widen_to is not None and len(widen_to):
+                angles = _euler(np.asarray(widen_to)[:, joints], order)  # (P, G, 3)
+                lo, hi = np.minimum(lo, angles.min(axis=0)), np.maximum(hi, angles.max(axis=0))
+            self.groups.append((order, np.array(joints), lo, hi))
 
     def clamp(self, local_rot: np.ndarray) -> np.ndarray:
         """``local_rot (..., J, 4)`` wxyz with every limited joint inside its ranges."""
         out = np.array(local_rot, dtype=float)
         for order, joints, lo, hi in self.groups:
             q = out[..., joints, :]
-            angles = Rotation.from_quat(q.reshape(-1, 4)[:, [1, 2, 3, 0]]).as_euler(order)
-            angles = angles.reshape(*q.shape[:-1], 3)
+            angles = _euler(q, order)
             clipped = np.clip(angles, lo, hi)
             changed = np.any(clipped != angles, axis=-1)
             if not np.any(changed):
@@ -65,3 +75,9 @@ class JointLimits:
             rebuilt = xyzw[:, [3, 0, 1, 2]].reshape(q.shape)
             out[..., joints, :] = np.where(changed[..., None], rebuilt, q)
         return out
+
+
+def _euler(q: np.ndarray, order: str) -> np.ndarray:
+    """``(..., 4)`` wxyz -> ``(..., 3)`` intrinsic Euler angles in ``order``."""
+    angles = Rotation.from_quat(q.reshape(-1, 4)[:, [1, 2, 3, 0]]).as_euler(order)
+    return angles.reshape(*q.shape[:-1], 3)

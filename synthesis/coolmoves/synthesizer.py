@@ -85,7 +85,7 @@ class CoolMoves(Synthesizer):
         self.user_height_m = user_height_m
         self._matchers = self._make_matchers()
         self._groups = joint_groups(database.limb_masks)
-        self._limits = JointLimits(database.skeleton)
+        self._limits = JointLimits(database.skeleton, widen_to=database.poses)
         ref = database.skeleton
         rig = identify_rig(ref)
         self._head_chain = ref.chain(ref.index(rig.body17["head"]))
@@ -156,13 +156,16 @@ class CoolMoves(Synthesizer):
         b, k = windows.shape[0], self._matchers[0].k
         dist = np.full((2, b, k), np.inf)
         idx = np.full((2, b, k), -1)
+        match_weights = np.zeros((2, b, k))
         for side in (0, 1):
             rows = np.flatnonzero(tracked[:, side])
             if rows.size:
-                dist[side, rows], idx[side, rows] = self._matchers[side].query(
-                    search_vectors(windows[rows, :, side])
-                )
-        weights, confidence = group_weights(dist[0], dist[1], opts.max_distance)
+                dist[side, rows], idx[side, rows], match_weights[side, rows] = self._matchers[
+                    side
+                ].query(search_vectors(windows[rows, :, side]))
+        weights, confidence = group_weights(
+            dist[0], dist[1], opts.max_distance, match_weights[0], match_weights[1]
+        )
         entries = np.concatenate([idx[0], idx[1]], axis=1)  # (B, 2k)
         safe = np.maximum(entries, 0)
         rotations = db.poses[db.entry_pose[safe]]  # (B, 2k, J, 4)

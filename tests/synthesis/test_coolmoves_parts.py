@@ -92,7 +92,7 @@ def test_query_identical_to_database_window_returns_it(small_db):
     for side in (0, 1):
         matcher = KNNMatcher(small_db.search[side], k=5, max_distance=0.5)
         i = small_db.n_windows // 3
-        dist, idx = matcher.query(search_vectors(small_db.windows[[i], :, side]))
+        dist, idx, _ = matcher.query(search_vectors(small_db.windows[[i], :, side]))
         assert dist[0, 0] == 0.0
         np.testing.assert_array_equal(
             small_db.windows[idx[0, 0], :, side], small_db.windows[i, :, side]
@@ -103,7 +103,7 @@ def test_query_identical_to_database_window_returns_it(small_db):
 def test_knn_threshold_drops_far_matches(small_db):
     matcher = KNNMatcher(small_db.search[0], k=5, max_distance=1e-6)
     far = small_db.windows[[0], :, 0] + 1.0
-    dist, idx = matcher.query(search_vectors(far))
+    dist, idx, _ = matcher.query(search_vectors(far))
     assert np.all(np.isinf(dist)) and np.all(idx == -1)
 
 
