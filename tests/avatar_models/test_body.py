@@ -129,3 +129,47 @@ def test_a_rest_pose_that_does_not_stand_is_refused():
     # bandai.toml keeps the BVH's baked joint orientations: its rest pose is a crumpled heap.
     with pytest.raises(BodyError, match="not upright"):
         build_body(load_rig("bandai").skeleton)
+
+
+@pytest.mark.parametrize("side", "LR")
+def test_foot_splits_at_the_ball_into_hindfoot_and_toe_boxes_on_one_sole(avatar, side):
+    sk = avatar.skeleton
+    ankle, toe = sk.index(f"Bip01 {side} Foot"), sk.index(f"Bip01 {side} Toe0")
+    rest = sk.rest_positions()
+    hind, toes = (
+        next(s for s in avatar.segments if s.kind == "foot" and s.body == b) for b in (ankle, toe)
+    )
+    assert hind.shape == toes.shape == "box"
+
+    def x_span(s):  # rest-pose world x of a box's back and front faces
+        centre = s.start + rest[s.body]
+        return centre[0] - s.half_extents[0], centre[0] + s.half_extents[0]
+
+    # avatar.toml: heel joint 0.05 m behind the ankle, ball 0.144 m and toe tip 0.216 m in front;
+    # the foot's ANSUR length (0.27 m of a 1.756 m man) reaches 3 mm beyond that tip.
+    length = 0.270 / 1.756 * avatar.stature
+    x_ankle = rest[ankle, 0]
+    np.testing.assert_allclose(np.subtract(x_span(hind), x_ankle), (-0.05, 0.144), atol=1e-9)
+    np.testing.assert_allclose(
+        np.subtract(x_span(toes), x_ankle), (0.144, length - 0.05), atol=1e-9
+    )
+    # One sole, on the floor in the rest pose (heels and toe tips on the floor).
+    soles = [s.lowest_z() + rest[s.body, 2] for s in (hind, toes)]
+    np.testing.assert_allclose(soles, -avatar.root_height + rest[0, 2], atol=1e-9)
+    # de Leva's foot mass split by length; the foot's CoM stays 44.15 % from the heel.
+    foot_mass = 0.0137 * avatar.mass_kg
+    assert toes.mass == pytest.approx(foot_mass * (length - 0.194) / length, rel=1e-9)
+    assert hind.mass + toes.mass == pytest.approx(foot_mass, rel=1e-9)
+    com = (hind.mass * (hind.com + rest[ankle]) + toes.mass * (toes.com + rest[toe])) / foot_mass
+    assert com[0] - x_ankle == pytest.approx(-0.05 + 0.4415 * length, abs=1e-9)
+
+
+def test_toe_hinges_have_aaos_mtp_ranges(avatar):
+    for side in "LR":
+        deg = {
+            a: np.degrees(r)
+            for a, r in avatar.hinge_ranges[avatar.skeleton.index(f"Bip01 {side} Toe0")].items()
+        }
+        np.testing.assert_allclose(deg["y"], (-70, 45))  # MTP extension 70, flexion 45
+        for axis in "xz":
+            assert np.ptp(deg[axis]) <= 10.0

@@ -190,3 +190,47 @@ def test_qpos_replays_real_cmu_mocap_exactly(mocap_dir):
         data.qpos[:] = qpos[t]
         mujoco.mj_kinematics(model, data)
         np.testing.assert_allclose(data.xpos[body_ids], expected[t], atol=1e-6)
+
+
+@pytest.mark.parametrize("rig", RIGS)
+def test_toes_are_hinged_bodies_not_colliding_with_their_foot(rig):
+    body = build_body(load_rig(rig).skeleton)
+    model, _ = _model(body)
+    excluded = {
+        frozenset((a, b))
+        for a, b in zip(
+            model.exclude_signature >> 16, model.exclude_signature & 0xFFFF, strict=True
+        )
+    }
+    for side in "lr":
+        ankle = body.skeleton.names[body.anatomy.body17[f"{side}_ankle"]]
+        toe = body.skeleton.names[body.anatomy.body17[f"{side}_foot"]]
+        assert model.body(toe).parentid[0] == model.body(ankle).id
+        assert model.body(toe).jntnum[0] == 3
+        assert model.actuator(hinge_name(toe, "y")).trntype == mujoco.mjtTrn.mjTRN_JOINT
+        assert frozenset((model.body(ankle).id, model.body(toe).id)) in excluded
+        toe_geoms = [s for s in body.segments if s.body == body.skeleton.index(toe)]
+        assert [s.kind for s in toe_geoms] == ["foot"]
+
+
+def test_generated_walk_rolls_over_the_toes_without_sinking_into_the_floor():
+    from avatar_models.generator import generate
+
+    motion = generate("walk", duration_s=2.0, fps=60.0)
+    body = build_body(motion.skeleton)
+    model, data = _model(body)
+    qpos = body.qpos_from_motion(motion)
+    toe_flexion = qpos[:, model.joint(hinge_name("Bip01 L Toe0", "y")).qposadr[0]]
+    assert toe_flexion.min() < np.radians(-20.0)  # push-off bends the toes up
+    floor = model.geom("floor").id
+    deepest = np.zeros(len(qpos))
+    for t, q in enumerate(qpos):
+        data.qpos[:] = q
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_collision(model, data)
+        con = data.contact[: data.ncon]
+        on_floor = (con.geom1 == floor) | (con.geom2 == floor)
+        deepest[t] = max(0.0, -con.dist[on_floor].min(initial=0.0))
+    # A rigid heel-to-toe box sank about 3 cm at push-off, a sole reaching behind the heel
+    # joint (the pivot of the heel rocker) 3.6 mm after heel strike.
+    assert deepest.max() < 0.001
