@@ -95,7 +95,7 @@ class PlausibilityReport:
 
     @property
     def failed_checks(self) -> list[str]:
-        return [row["check"] for row in self.thresholds if not row["passed"]]
+        return list(dict.fromkeys(row["check"] for row in self.thresholds if not row["passed"]))
 
     @property
     def passed(self) -> bool:

@@ -2,7 +2,11 @@
 
 The hinge angles are the motion's exact qpos (:meth:`BodyDescription.qpos_from_motion`), the
 ranges MuJoCo's ``jnt_range`` (the body's AAOS ranges). A frame violates when any hinge is
-beyond its range by more than ``limit_tolerance_deg``.
+beyond its range by more than ``limit_tolerance_deg``. Hinges whose whole range is narrower
+than ``limit_min_range_deg`` are not checked: they are the small allowances the body gives
+degrees of freedom a joint does not have anatomically (knee and elbow varus/valgus, pelvic
+girdle) so that replay stays exact, and the skeleton fitting of real mocap puts its error
+(and the elbow's carrying angle) there.
 """
 
 from __future__ import annotations
@@ -20,7 +24,9 @@ class JointLimits:
 
     def __call__(self, replay: BodyReplay, config: CheckConfig) -> CheckResult:
         model = replay.model
-        hinges = np.flatnonzero(model.jnt_type == mujoco.mjtJoint.mjJNT_HINGE)
+        width = np.degrees(np.diff(model.jnt_range, axis=1)[:, 0])
+        hinge = model.jnt_type == mujoco.mjtJoint.mjJNT_HINGE
+        hinges = np.flatnonzero(hinge & (width >= config.limit_min_range_deg))
         angle = replay.qpos[:, model.jnt_qposadr[hinges]]  # (T, H)
         lo, hi = model.jnt_range[hinges].T
         excess = np.degrees(np.maximum(np.maximum(lo - angle, angle - hi), 0.0))  # (T, H)

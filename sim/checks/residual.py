@@ -16,21 +16,33 @@ import copy
 
 import mujoco
 import numpy as np
+from scipy.signal import butter, sosfiltfilt
 
 from sim.checks.base import CheckResult
 from sim.checks.replay import BodyReplay
 from sim.thresholds import CheckConfig
 
 
+def lowpass(x: np.ndarray, fps: float, cutoff_hz: float) -> np.ndarray:
+    """Zero-lag 4th-order Butterworth low-pass of ``x (T, ...)`` over time (unchanged when the
+    cutoff is at or above Nyquist or the clip is too short to filter)."""
+    if cutoff_hz <= 0 or cutoff_hz >= 0.5 * fps or x.shape[0] < 16:
+        return x
+    sos = butter(2, cutoff_hz, fs=fps, output="sos")  # order 2 forward + backward = 4
+    return sosfiltfilt(sos, x, axis=0)
+
+
 def finite_qvel_qacc(
-    model: mujoco.MjModel, qpos: np.ndarray, fps: float
+    model: mujoco.MjModel, qpos: np.ndarray, fps: float, cutoff_hz: float = 0.0
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(T, nv)`` velocities (mean of the backward and forward differences) and
-    accelerations (second differences) of ``qpos (T, nq)``; the ends repeat their neighbour."""
+    accelerations (second differences) of ``qpos (T, nq)``; the ends repeat their neighbour.
+    Differences are low-passed at ``cutoff_hz`` (0: not filtered)."""
     n, dt = qpos.shape[0], 1.0 / fps
     step = np.zeros((max(n - 1, 0), model.nv))  # step[t] = (q[t+1] - q[t]) / dt
     for t in range(n - 1):
         mujoco.mj_differentiatePos(model, step[t], dt, qpos[t], qpos[t + 1])
+    step = lowpass(step, fps, cutoff_hz)
     if n < 3:
         return np.zeros((n, model.nv)), np.zeros((n, model.nv))
     qvel = np.empty((n, model.nv))
@@ -51,12 +63,14 @@ def cone_distance(force: np.ndarray, mu: float) -> np.ndarray:
     return np.where(inside, 0.0, np.where(polar, np.hypot(s, z), to_surface))
 
 
-def root_force(model: mujoco.MjModel, qpos: np.ndarray, fps: float) -> np.ndarray:
+def root_force(
+    model: mujoco.MjModel, qpos: np.ndarray, fps: float, cutoff_hz: float = 0.0
+) -> np.ndarray:
     """``(T, 3)`` world force on the free root that ``qpos (T, nq)`` needs, contacts off."""
     free = copy.deepcopy(model)
     free.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
     data = mujoco.MjData(free)
-    qvel, qacc = finite_qvel_qacc(free, qpos, fps)
+    qvel, qacc = finite_qvel_qacc(free, qpos, fps, cutoff_hz)
     force = np.empty((qpos.shape[0], 3))
     for t in range(qpos.shape[0]):  # mj_inverse evaluates one state per call
         data.qpos[:], data.qvel[:], data.qacc[:] = qpos[t], qvel[t], qacc[t]
@@ -70,7 +84,7 @@ class ResidualForce:
 
     def __call__(self, replay: BodyReplay, config: CheckConfig) -> CheckResult:
         model = replay.model
-        force = root_force(model, replay.qpos, replay.fps)
+        force = root_force(model, replay.qpos, replay.fps, config.residual_cutoff_hz)
         weight = model.body_mass.sum() * np.linalg.norm(model.opt.gravity)
         residual = (
             np.where(

@@ -1,0 +1,68 @@
+"""``avatarsim check MOTION``: physics plausibility of a motion on the humanoid.
+
+Prints the summary table, writes per-frame CSV, the contract JSON and a plot into ``--out``,
+optionally the MJCF and keyframes for MuJoCo's viewer into ``--export``. Exit 1 when a
+threshold fails, 2 for bad input (NaN, no frames, unknown rig, a rig that needs retargeting).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from scripts.cli_common import JsonOpt, SeedOpt, console, emit_json, unit_option, user_errors
+
+
+def register(app: typer.Typer) -> None:
+    @app.command()
+    @user_errors
+    def check(
+        motion: Annotated[Path, typer.Argument(help="A .bvh, .amc (ASF beside it) or .npz file.")],
+        out: Annotated[Path, typer.Option(help="Folder for CSV, JSON and plot.")] = Path(
+            "out/check"
+        ),
+        export: Annotated[
+            Path | None, typer.Option(help="Also write MJCF + keyframes for MuJoCo's viewer.")
+        ] = None,
+        config: Annotated[
+            Path | None, typer.Option(help="TOML with definitions/thresholds to override.")
+        ] = None,
+        unit: Annotated[str | None, typer.Option(help="File unit (see `info`).")] = None,
+        seed: SeedOpt = 0,
+        json_out: JsonOpt = None,
+    ) -> None:
+        """Physics plausibility of a motion on the MuJoCo humanoid. Exit 1 if a check fails."""
+        from avatar_models.formats import load_motion
+        from sim.plausibility import body_and_motion, check_motion
+        from sim.report import summary_rows, write_outputs
+        from sim.thresholds import CheckConfig
+
+        cfg = CheckConfig.from_toml(config) if config is not None else CheckConfig()
+        m = load_motion(motion, **unit_option(unit))
+        body, m = body_and_motion(m, None)
+        report = check_motion(m, body, cfg)
+        report.meta.update(path=str(motion), seed=seed)
+        table = Table(title=f"physics plausibility: {motion}")
+        for col in ("check", "value", "threshold", "passed"):
+            table.add_column(col)
+        for name, value, limit, ok in summary_rows(report):
+            table.add_row(
+                name, f"{value:.4g}", f"{limit:g}", "[green]yes[/]" if ok else "[red]NO[/]"
+            )
+        console.print(table)
+        written = write_outputs(report, out)
+        if export is not None:
+            from sim.export import export_replay
+
+            export_replay(body, body.qpos_from_motion(m), m.fps, export)
+            console.print(
+                f"MuJoCo viewer files in {export}/ (python -m mujoco.viewer --mjcf "
+                f"{export}/replay.xml)"
+            )
+        console.print(f"wrote {', '.join(str(p) for p in written.values())}")
+        emit_json(json_out, report.contract())
+        if not report.passed:
+            raise typer.Exit(1)
