@@ -154,34 +154,35 @@ def depth_edge_partner(depth: np.ndarray, jump_m: float) -> np.ndarray:
 def incidence_angles(depth: np.ndarray, K: np.ndarray) -> np.ndarray:
     """``(H, W)`` angle (radians) between each pixel's viewing ray and its surface normal.
 
-    Points are back-projected through ``K``; tangents along u and v use the one-sided
-    difference with the smaller depth change, so a pixel on a depth edge gets the normal of
-    its own surface rather than of the jump. 0 where the depth is 0.
+    With the ray ``r = ((u - cx) / fx, (v - cy) / fy, 1)`` and the point ``z r``, the normal is
+    ``n = (-fx dz/du, -fy dz/dv, fx r_x dz/du + fy r_y dz/dv + z)`` and ``n . r = z``, so
+    ``cos(theta) = z / (|n| |r|)``. Depth derivatives use the one-sided difference with the
+    smaller change, so a pixel on a depth edge gets the normal of its own surface rather than
+    of the jump. 0 where the depth is 0.
     """
     depth = np.asarray(depth, float)
     h, w = depth.shape
-    v, u = np.mgrid[0:h, 0:w]
-    rays = np.stack([(u - K[0, 2]) / K[0, 0], (v - K[1, 2]) / K[1, 1], np.ones((h, w))], -1)
-    points = depth[..., None] * rays
-    tangents = [_smooth_difference(points, axis) for axis in (1, 0)]
-    normal = np.cross(tangents[0], tangents[1])
-    cos = np.abs(np.sum(normal * rays, -1)) / (
-        np.linalg.norm(normal, axis=-1) * np.linalg.norm(rays, axis=-1) + 1e-12
-    )
-    theta = np.arccos(np.clip(cos, 0.0, 1.0))
-    return np.where(depth > 0, theta, 0.0)
+    rx = ((np.arange(w) - K[0, 2]) / K[0, 0])[None, :]
+    ry = ((np.arange(h) - K[1, 2]) / K[1, 1])[:, None]
+    du = K[0, 0] * _smooth_difference(depth, axis=1)
+    dv = K[1, 1] * _smooth_difference(depth, axis=0)
+    normal_z = rx * du + ry * dv + depth
+    normal_norm = np.sqrt(du * du + dv * dv + normal_z * normal_z)
+    ray_norm = np.sqrt(rx * rx + ry * ry + 1.0)
+    cos = depth / np.maximum(normal_norm * ray_norm, 1e-12)
+    return np.where(depth > 0, np.arccos(np.clip(cos, 0.0, 1.0)), 0.0)
 
 
-def _smooth_difference(points: np.ndarray, axis: int) -> np.ndarray:
-    """``(H, W, 3)`` forward or backward difference along image ``axis``, whichever changes
-    depth less (one-sided at the image border)."""
-    forward = np.diff(points, axis=axis, append=np.take(points, [-1], axis=axis))
-    backward = np.diff(points, axis=axis, prepend=np.take(points, [0], axis=axis))
-    # At the border one of them is 0 and the other is the only real difference.
-    forward = np.where(np.all(forward == 0, -1, keepdims=True), backward, forward)
-    backward = np.where(np.all(backward == 0, -1, keepdims=True), forward, backward)
-    use_forward = np.abs(forward[..., 2]) <= np.abs(backward[..., 2])
-    return np.where(use_forward[..., None], forward, backward)
+def _smooth_difference(depth: np.ndarray, axis: int) -> np.ndarray:
+    """``(H, W)`` forward or backward depth difference along image ``axis``, whichever is
+    smaller in magnitude (the only one there is at the image border)."""
+    step = np.diff(depth, axis=axis)
+    first = [slice(None)] * 2
+    last = [slice(None)] * 2
+    first[axis], last[axis] = slice(0, 1), slice(-1, None)
+    forward = np.concatenate([step, step[tuple(last)]], axis=axis)
+    backward = np.concatenate([step[tuple(first)], step], axis=axis)
+    return np.where(np.abs(forward) <= np.abs(backward), forward, backward)
 
 
 KINECT_V2_NOISE = DepthNoiseModel()
