@@ -8,6 +8,8 @@ the built-in generator.
   positions of the hands as independent time series ... for the entire session", averaged
   over the three axes. We correlate head-relative positions (controller minus headset, the
   signal CoolMoves is given) so that walking forward cannot inflate the number.
+- Both skip the first ``window - 1`` frames (89 ms), before the first full window exists,
+  when any window-based method can only show a default pose.
 - Cross-subject (§4.1.1): per activity, the database holds every other subject's take and the
   held-out subject is synthesised from its simulated headset and controllers.
 """
@@ -26,12 +28,14 @@ from render_cams.device import motion_at_rate
 from synthesis.base import Synthesizer, on_clock, usable_mask
 from synthesis.coolmoves.correlation import pearson
 from synthesis.coolmoves.database import HANDS_DRIVE, Drivers, build_database, driver_positions
+from synthesis.coolmoves.features import WINDOW_SAMPLES
 from synthesis.coolmoves.synthesizer import CoolMoves, Options
 
 PAPER_ACTIVITIES = ("box", "dribble", "climb_ladder", "run", "swim")
 """The generator's counterparts of the paper's Table 1 (boxing, basketball, climbing a ladder,
 running, swimming)."""
 
+WARM_UP = WINDOW_SAMPLES - 1
 _GROUPS = {
     "hands": body17.HANDS,
     "upper": body17.UPPER,
@@ -40,24 +44,27 @@ _GROUPS = {
 }
 
 
-def body17_errors_cm(output: Motion, truth: Motion) -> dict[str, float]:
-    """Mean joint error in cm per group over the frames both motions have (at 90 Hz)."""
+def body17_errors_cm(output: Motion, truth: Motion, skip: int = WARM_UP) -> dict[str, float]:
+    """Mean joint error in cm per group over the frames both motions have (at 90 Hz),
+    after the first ``skip``."""
     truth = motion_at_rate(truth, output.fps)
     n = min(output.n_frames, truth.n_frames)
     err = np.linalg.norm(body17_positions(output)[:n] - body17_positions(truth)[:n], axis=-1)
+    err = err[min(skip, n - 1) :]
     per_joint = 100.0 * err.mean(axis=0)
     return {g: float(per_joint[body17.group_indices(names)].mean()) for g, names in _GROUPS.items()}
 
 
 def hand_correlation(
-    output: Motion, stream: TrackingStream, drivers: Drivers = HANDS_DRIVE
+    output: Motion, stream: TrackingStream, drivers: Drivers = HANDS_DRIVE, skip: int = WARM_UP
 ) -> dict[str, float]:
     """Pearson correlation of input and output head-relative hands, mean over x, y, z."""
     clocked = on_clock(stream)
     idx = [clocked.device(d) for d in drivers.devices]
     ok = usable_mask(clocked)[:, idx].all(axis=1)
     n = min(output.n_frames, clocked.n_samples)
-    ok = ok[:n]
+    ok = ok[:n].copy()
+    ok[:skip] = False
     given = clocked.positions[:n, idx[1:]] - clocked.positions[:n, idx[:1]]
     head, sides = driver_positions(output[:n], drivers)
     produced = sides - head[:, None]
