@@ -21,7 +21,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import cv2
 import numpy as np
 
 from avatar_models import AvatarsimError
@@ -140,20 +139,25 @@ class FisheyeModel:
         theta = np.nan_to_num(self.angle_of_pixels(edges), nan=HALF_PI)
         return float(theta[0] + theta[1]), float(theta[2] + theta[3])
 
+    def unproject(self, uv: np.ndarray) -> np.ndarray:
+        """Unit rays ``(..., 3)`` (camera frame) of pixels ``uv`` ``(..., 2)``; NaN beyond the
+        image circle. Same as ``cv2.fisheye.undistortPoints`` where that is defined: OpenCV
+        clamps ``theta_d`` to 90 deg, which a wide lens with ``k1 > 0`` exceeds in its corners,
+        so the angle is inverted here (:meth:`angle_of_pixels`) for every pixel."""
+        uv = np.asarray(uv, dtype=float)
+        xd = (uv[..., 0] - self.K[0, 2]) / self.K[0, 0]
+        yd = (uv[..., 1] - self.K[1, 2]) / self.K[1, 1]
+        theta = self.angle_of_pixels(uv)
+        theta_d = np.hypot(xd, yd)
+        radial = np.where(theta_d > 0, np.sin(theta) / np.maximum(theta_d, 1e-300), 1.0)
+        return np.stack([xd * radial, yd * radial, np.cos(theta)], axis=-1)
+
     def rays(self) -> tuple[np.ndarray, np.ndarray]:
-        """Unit ray ``(H, W, 3)`` of every pixel centre (camera frame) through
-        ``cv2.fisheye.undistortPoints``, and ``(H, W)`` bool: inside the image circle."""
+        """Unit ray ``(H, W, 3)`` of every pixel centre (camera frame) and ``(H, W)`` bool:
+        inside the image circle (rays outside are NaN)."""
         v, u = np.mgrid[0 : self.height, 0 : self.width].astype(np.float64)
-        uv = np.stack([u, v], axis=-1).reshape(-1, 1, 2)
-        criteria = (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-12)
-        xy = cv2.fisheye.undistortPoints(uv, self.K, self.D, criteria=criteria).reshape(
-            self.height, self.width, 2
-        )
-        inside = np.isfinite(self.angle_of_pixels(np.stack([u, v], axis=-1)))
-        rays = np.concatenate([xy, np.ones((self.height, self.width, 1))], axis=-1)
-        rays /= np.linalg.norm(rays, axis=-1, keepdims=True)
-        rays[~inside] = np.nan
-        return rays, inside
+        rays = self.unproject(np.stack([u, v], axis=-1))
+        return rays, np.all(np.isfinite(rays), axis=-1)
 
     def project(self, points_cam: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Pixels ``(..., 2)`` of camera-frame points ``(..., 3)`` (as
