@@ -1,7 +1,8 @@
 """``BodyReplay``: a motion replayed on its humanoid, with the quantities several checks share.
 
-Shapes: ``T`` frames, feet ordered (left, right), sole points per foot ordered (heel, toe),
-sole corners per foot (heel-left, heel-right, toe-left, toe-right). Sole points lie on the
+Shapes: ``T`` frames, feet ordered (left, right), ``K`` foot primitives per side (a foot box,
+and a toe box on rigs with simulated toes), sole points per primitive (heel, toe), sole
+corners per primitive (heel-left, heel-right, toe-left, toe-right). Sole points lie on the
 bottom face of each foot primitive (box or capsule) of :class:`avatar_models.body.Segment`,
 moved with MuJoCo's body frames, so contacts follow the simulated geometry, not joints.
 """
@@ -87,41 +88,43 @@ class BodyReplay:
         return self.qpos.shape[0]
 
     @cached_property
-    def foot_bodies(self) -> np.ndarray:
-        """``(2,)`` MuJoCo body ids carrying the left and right foot primitives."""
-        return np.array([self.model.body(self.body.skeleton.names[s.body]).id for s in self._feet])
-
-    @cached_property
-    def _feet(self) -> tuple[Segment, Segment]:
-        feet = {s.side: s for s in self.body.segments if s.kind == "foot"}
-        return feet["left"], feet["right"]
+    def _feet(self) -> tuple[tuple[Segment, ...], tuple[Segment, ...]]:
+        """Foot primitives per side (some rigs have a foot and a toe primitive per side)."""
+        return tuple(
+            tuple(s for s in self.body.segments if s.kind == "foot" and s.side == side)
+            for side in SIDES
+        )
 
     @cached_property
     def _sole_world(self) -> np.ndarray:
-        """``(T, 2, 6, 3)`` heel, toe and corners of both soles in the world."""
-        local = np.stack([_sole_points(s) for s in self._feet])  # (2, 6, 3)
-        pos = self.trace.body_pos[:, self.foot_bodies]  # (T, 2, 3)
-        rot = self.trace.body_rot[:, self.foot_bodies]  # (T, 2, 3, 3)
-        return pos[:, :, None] + np.einsum("tfij,fpj->tfpi", rot, local)
+        """``(T, 2, K, 6, 3)`` heel, toe and corners of the ``K`` foot primitives per side."""
+        names = self.body.skeleton.names
+        local = np.stack([[_sole_points(s) for s in side] for side in self._feet])  # (2,K,6,3)
+        ids = np.array([[self.model.body(names[s.body]).id for s in side] for side in self._feet])
+        pos = self.trace.body_pos[:, ids]  # (T, 2, K, 3)
+        rot = self.trace.body_rot[:, ids]  # (T, 2, K, 3, 3)
+        return pos[:, :, :, None] + np.einsum("tfkij,fkpj->tfkpi", rot, local)
 
     @property
     def sole_points(self) -> np.ndarray:
-        """``(T, 2, 2, 3)`` heel and toe of each sole."""
-        return self._sole_world[:, :, :2]
+        """``(T, 2, P, 3)`` heel and toe of each foot primitive (``P = 2K``) per side."""
+        w = self._sole_world[:, :, :, :2]
+        return w.reshape(w.shape[0], 2, -1, 3)
 
     @property
     def sole_corners(self) -> np.ndarray:
-        """``(T, 2, 4, 3)`` the four corners of each sole."""
-        return self._sole_world[:, :, 2:]
+        """``(T, 2, 4K, 3)`` the corners of each side's sole primitives."""
+        w = self._sole_world[:, :, :, 2:]
+        return w.reshape(w.shape[0], 2, -1, 3)
 
     @cached_property
     def sole_velocity(self) -> np.ndarray:
-        """``(T, 2, 2, 3)`` velocity of heel and toe of each sole (m/s)."""
+        """``(T, 2, P, 3)`` velocity of the sole points (m/s)."""
         return finite_speed(self.sole_points, self.fps)
 
     @cached_property
     def point_contact(self) -> np.ndarray:
-        """``(T, 2, 2)`` heel/toe of each foot in contact: low AND not moving vertically."""
+        """``(T, 2, P)`` sole points in contact: low AND not moving vertically."""
         c = self.config
         low = self.sole_points[..., 2] < c.contact_height_m
         still = np.abs(self.sole_velocity[..., 2]) < c.contact_vz_m_s

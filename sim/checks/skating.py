@@ -39,8 +39,8 @@ class Skating:
     name = "skating"
 
     def __call__(self, replay: BodyReplay, config: CheckConfig) -> CheckResult:
-        contact = replay.point_contact  # (T, 2, 2)
-        speed = 100.0 * np.linalg.norm(replay.sole_velocity[..., :2], axis=-1)  # (T, 2, 2)
+        contact = replay.point_contact  # (T, 2, P)
+        speed = 100.0 * np.linalg.norm(replay.sole_velocity[..., :2], axis=-1)  # (T, 2, P)
         n_in_contact = contact.sum(axis=2)
         foot_speed = np.where(contact, speed, np.inf).min(axis=2)  # (T, 2)
         foot_speed[n_in_contact == 0] = np.nan
@@ -59,7 +59,7 @@ class Skating:
             values={
                 "skate_cm_s_median": max(medians),
                 "skate_frac": float(skating.sum() / max(in_contact.sum(), 1)),
-                "skate_slide_cm_max": 100.0 * max((s.max(initial=0.0) for s in slides)),
+                "skate_slide_cm_max": 100.0 * max(s.max(initial=0.0) for s in slides),
             },
             flagged=skating.any(axis=1),
             details={

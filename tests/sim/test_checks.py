@@ -1,0 +1,75 @@
+"""Individual checks against analytic cases: residual force, friction cone, config, skating."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from avatar_models.body import build_body
+from avatar_models.generator import generate
+from avatar_models.motion import Motion
+from sim.checks.residual import cone_distance
+from sim.checks.skating import contact_runs
+from sim.plausibility import check_motion
+from sim.thresholds import CheckConfig, ConfigError
+
+
+@pytest.fixture(scope="module")
+def rest_body():
+    skeleton = generate("balance", duration_s=0.1).skeleton
+    return build_body(skeleton)
+
+
+def still_pose(body, height_above_rest: float, frames: int = 60) -> Motion:
+    """The rest pose, standing on the floor (``height_above_rest=0``) or held above it."""
+    rot = np.zeros((frames, body.skeleton.n_joints, 4))
+    rot[..., 0] = 1.0
+    root = np.zeros((frames, 3))
+    root[:, 2] = body.root_height + height_above_rest
+    return Motion(body.skeleton, 60.0, root, rot)
+
+
+def test_residual_force_zero_standing_one_body_weight_in_the_air(rest_body):
+    standing = check_motion(still_pose(rest_body, 0.0), rest_body)
+    hanging = check_motion(still_pose(rest_body, 0.5), rest_body)
+    assert standing.values["residual_force_bw_p95"] < 0.01
+    np.testing.assert_allclose(hanging.values["residual_force_bw_p95"], 1.0, atol=0.02)
+    assert standing.passed and hanging.flagged("residual_force")
+
+
+def test_standing_pose_touches_floor_without_penetrating(rest_body):
+    r = check_motion(still_pose(rest_body, 0.0), rest_body)
+    assert r.values["penetration_cm_p95"] < 0.1
+    assert r.values["contact_frac"] == 1.0 and r.values["skate_cm_s_median"] < 1e-6
+    assert r.values["com_outside_support_frac"] == 0.0  # CoM between the feet
+
+
+def test_ballistic_flight_needs_no_residual_force(rest_body):
+    """A body in free fall (root following -g/2 t^2, high above the floor) needs no force."""
+    m = still_pose(rest_body, 1.0, frames=90)
+    t = m.times
+    root = m.root_pos.copy()
+    root[:, 2] += 2.0 * t - 0.5 * 9.81 * t**2
+    r = check_motion(m.replace(root_pos=root), rest_body)
+    assert np.percentile(r.per_frame()["residual_force_bw"][5:-5], 95) < 0.02
+
+
+def test_cone_distance_analytic():
+    f = np.array([[0, 0, 1.0], [2.0, 0, 1.0], [0, 0, -1.0], [1.0, 0, 0.0]])
+    np.testing.assert_allclose(cone_distance(f, 1.0), [0.0, 1 / np.sqrt(2), 1.0, 1 / np.sqrt(2)])
+
+
+def test_contact_runs():
+    runs = contact_runs(np.array([0, 1, 1, 0, 1, 0, 1, 1, 1], dtype=bool))
+    np.testing.assert_array_equal(runs, [[1, 2], [4, 4], [6, 8]])
+
+
+def test_config_from_dict_and_toml(tmp_path):
+    assert CheckConfig.from_dict({"penetration_cm_p95": 2}).penetration_cm_p95 == 2.0
+    with pytest.raises(ConfigError, match="unknown"):
+        CheckConfig.from_dict({"no_such_key": 1.0})
+    with pytest.raises(ConfigError, match=">= 0"):
+        CheckConfig.from_dict({"friction": -1.0})
+    path = tmp_path / "c.toml"
+    path.write_text("[checks]\ncontact_height_m = 0.03\n")
+    assert CheckConfig.from_toml(path).contact_height_m == 0.03
