@@ -9,11 +9,10 @@ Sources:
   1024 x 1024, 120 x 120 deg, 0.25-2.21 m (15 fps in the real device; simulated at 30 Hz
   with the others so every stream shares the skeleton rate).
 
-Every mode is modelled as an ideal pinhole with square pixels and the principal point at the
-image centre (the real lenses' distortion is calibrated away by the SDKs' point clouds). The
-horizontal field of view sets the focal length; the vertical one then follows from the aspect
-ratio (58.5 deg for V2's 70.6 deg, 63.0 deg for NFOV's 75 deg: within 2 deg of the quoted
-values, which are rounded and measured on distorted lenses).
+Every mode is modelled as an ideal pinhole with the principal point at the image centre (the
+real lenses' distortion is calibrated away by the SDKs' point clouds); the focal lengths
+``fx, fy`` reproduce both quoted fields of view exactly (for Kinect V2, fx = 361, fy = 367 px,
+close to the fx = fy = 365 px of factory calibrations).
 """
 
 from __future__ import annotations
@@ -65,15 +64,16 @@ class DepthSensor:
             )
         if self.width < 1 or self.height < 1:
             raise KinectError(f"{self.name}: image size must be positive")
-        h_fov = float(self.fov_deg[0])
-        if not 0.0 < h_fov < 180.0:
-            raise KinectError(f"{self.name}: horizontal field of view must be in (0, 180) deg")
+        if not all(0.0 < float(f) < 180.0 for f in self.fov_deg):
+            raise KinectError(f"{self.name}: fields of view must be in (0, 180) deg")
         object.__setattr__(self, "range_m", (near, far))
 
     @property
     def K(self) -> np.ndarray:
-        """``(3, 3)`` pinhole intrinsics (OpenCV conventions)."""
-        return pinhole_K(np.radians(self.fov_deg[0]), self.width, self.height)
+        """``(3, 3)`` pinhole intrinsics (OpenCV conventions) with both fields of view."""
+        K = pinhole_K(np.radians(self.fov_deg[0]), self.width, self.height)
+        K[1, 1] = 0.5 * self.height / np.tan(0.5 * np.radians(self.fov_deg[1]))
+        return K
 
 
 SENSORS: dict[str, DepthSensor] = {
