@@ -1,0 +1,94 @@
+"""CoolMoves speed: per-frame ``step()`` latency and batch throughput, next to the paper.
+
+Database: the generator's five Table-1 activities for four subjects (two in ``quick`` mode),
+8 s each, all in one database; input: a held-out subject's boxing seen by the default
+``VRSetup``. Latency is the wall time of each ``step()`` call on one thread (the KD-tree
+query runs with ``workers=1``). Baselines are the paper's (CoolMoves §3.1.5, a Core i7-7700HQ):
+the Python backend ran at 152 Hz (6.6 ms a frame) and the mixture-model variant at 44 Hz
+(22.7 ms); a VR frame at 90 Hz leaves 11.1 ms.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from avatar_models.generator import generate, sample_subject
+from render_cams import VRSetup
+from scripts.benchmarks import BenchRow, best_of
+from synthesis.base import TrackingFrame
+from synthesis.coolmoves import CoolMoves, Options, build_database
+from synthesis.coolmoves.accuracy import PAPER_ACTIVITIES
+
+PAPER_BACKEND_MS = 1000.0 / 152.0
+PAPER_GMM_MS = 1000.0 / 44.0
+FRAME_BUDGET_MS = 1000.0 / 90.0
+
+
+def _step_latencies_ms(synth: CoolMoves, stream) -> np.ndarray:
+    frames = [TrackingFrame.from_stream(stream, i) for i in range(stream.n_samples)]
+    synth.reset()
+    out = np.empty(len(frames))
+    for i, frame in enumerate(frames):
+        t0 = time.perf_counter()
+        synth.step(frame)
+        out[i] = time.perf_counter() - t0
+    return 1e3 * out
+
+
+def run(quick: bool = False) -> list[BenchRow]:
+    rng = np.random.default_rng(0)
+    n_train = 2 if quick else 4
+    subjects = [sample_subject(rng) for _ in range(n_train + 1)]
+    motions = [
+        generate(a, s, 8.0, 90.0, seed=10 * i + j)
+        for i, s in enumerate(subjects[:n_train])
+        for j, a in enumerate(PAPER_ACTIVITIES)
+    ]
+    t0 = time.perf_counter()
+    database = build_database(motions)
+    build_s = time.perf_counter() - t0
+    held_out = subjects[-1]
+    stream = VRSetup().sample(generate("box", held_out, 4.0 if quick else 8.0, 90.0, seed=99))
+    synth = CoolMoves(database, held_out.height_m)
+    lat = _step_latencies_ms(synth, stream)
+    batch_s = best_of(lambda: synth.run(stream), repeat=2 if quick else 3)
+    gmm = CoolMoves(database, held_out.height_m, Options(matcher="gmm"))
+    gmm_lat = _step_latencies_ms(gmm, stream[: 180 if quick else 360])
+    note = f"{database.n_windows} windows, {stream.n_samples} frames"
+    return [
+        BenchRow(
+            "coolmoves step p50",
+            "ms",
+            float(np.percentile(lat, 50)),
+            PAPER_BACKEND_MS,
+            "paper Python backend (152 Hz)",
+            note,
+        ),
+        BenchRow(
+            "coolmoves step p99",
+            "ms",
+            float(np.percentile(lat, 99)),
+            FRAME_BUDGET_MS,
+            "90 Hz frame budget",
+            note,
+        ),
+        BenchRow(
+            "coolmoves batch run",
+            "frames/s",
+            stream.n_samples / batch_s,
+            152.0,
+            "paper Python backend (152 Hz)",
+            note,
+        ),
+        BenchRow(
+            "coolmoves-gmm step p50",
+            "ms",
+            float(np.percentile(gmm_lat, 50)),
+            PAPER_GMM_MS,
+            "paper mixture variant (44 Hz)",
+            note,
+        ),
+        BenchRow("coolmoves database build", "s", build_s, None, "", note),
+    ]
