@@ -14,6 +14,8 @@ from dataclasses import asdict, dataclass
 # name -> module under scripts.benchmarks; a new benchmark is a new module plus a line here.
 BENCHMARKS: dict[str, str] = {
     "formats": "formats",
+    "checks": "checks",
+    "coolmoves": "coolmoves",
 }
 
 
