@@ -73,3 +73,20 @@ def test_config_from_dict_and_toml(tmp_path):
     path = tmp_path / "c.toml"
     path.write_text("[checks]\ncontact_height_m = 0.03\n")
     assert CheckConfig.from_toml(path).contact_height_m == 0.03
+
+
+def test_support_margin_matches_scipy_convex_hull():
+    from scipy.spatial import ConvexHull
+
+    from sim.checks.support import outside_margin
+
+    rng = np.random.default_rng(3)
+    points = rng.uniform(-0.2, 0.2, size=(200, 8, 2))
+    active = rng.random((200, 8)) < 0.8
+    active[:, :3] = True
+    com = rng.uniform(-0.4, 0.4, size=(200, 2))
+    expected = []
+    for t in range(200):
+        eq = ConvexHull(points[t, active[t]]).equations
+        expected.append(max(0.0, np.max(eq[:, :2] @ com[t] + eq[:, 2])))
+    np.testing.assert_allclose(outside_margin(points, active, com), expected, atol=1e-9)

@@ -1,0 +1,47 @@
+"""Physics plausibility checking throughput, next to real time (90 Hz, a VR headset's rate).
+
+Rows, all on one core in this process: the kinematic replay alone (``mj_kinematics`` +
+``mj_collision`` per frame), every kinematic check (replay, contacts, penetration, floating,
+skating, joint limits, self-collision, jitter, balance), and everything including the root
+residual force (``mj_inverse`` per frame). Baseline: 90 frames/s, so the ratio reads as
+"times real time". Motion: a built-in walk (60 s; 10 s with ``quick``).
+"""
+
+from __future__ import annotations
+
+import mujoco
+
+from avatar_models.body import build_body
+from avatar_models.generator import generate
+from scripts.benchmarks import BenchRow, best_of
+from sim.checks import ALL_CHECKS
+from sim.plausibility import check_qpos
+from sim.replay import replay_kinematic
+
+REAL_TIME_HZ = 90.0
+
+
+def run(quick: bool = False) -> list[BenchRow]:
+    motion = generate("walk", duration_s=10.0 if quick else 60.0, fps=REAL_TIME_HZ)
+    body = build_body(motion.skeleton)
+    model = mujoco.MjModel.from_xml_string(body.to_mjcf())
+    qpos = body.qpos_from_motion(motion)
+    n = len(qpos)
+    kinematic = [c for c in ALL_CHECKS if c.name != "residual_force"]
+    cases = {
+        "replay_kinematic": lambda: replay_kinematic(model, qpos),
+        "checks_kinematic": lambda: check_qpos(body, qpos, motion.fps, None, kinematic, model),
+        "checks_all": lambda: check_qpos(body, qpos, motion.fps, None, ALL_CHECKS, model),
+    }
+    repeat = 2 if quick else 3
+    return [
+        BenchRow(
+            name,
+            "frames/s",
+            n / best_of(fn, repeat),
+            REAL_TIME_HZ,
+            "real time (90 Hz)",
+            f"{n} frames, {model.nbody - 1} bodies, {model.ngeom} geoms, one core",
+        )
+        for name, fn in cases.items()
+    ]
