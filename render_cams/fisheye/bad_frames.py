@@ -1,0 +1,101 @@
+"""Bad frames of analog wireless cameras: injection with ground truth, and a detector.
+
+ControllerPose §4.2: the analog transmissions "suffer from interference and occasional
+synchronization loss, resulting in unusable frames (roughly 1 in 50) that we filter". Three
+kinds are injected here, as they look on analog receivers:
+
+- ``noise_band``: one to three horizontal bands of strong snow (interference bursts);
+- ``tearing``: lost horizontal sync: from a random row down, the picture is shifted sideways
+  (wrapping) and a bright retrace line marks the tear;
+- ``black``: lost vertical sync / carrier: a near-black frame with faint noise.
+
+The detector needs no training data: a black frame has a low mean; a noise band raises the
+high-frequency energy of some rows far above the robust (median / MAD) level of the sequence;
+a tear shows its saturated retrace line.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from render_cams.device import DeviceError
+
+BAD_FRAME_RATE = 1.0 / 50.0  # ControllerPose §4.2
+KINDS = ("noise_band", "tearing", "black")
+Z_THRESHOLD = 50.0  # robust z-score of row snow energy above which a frame is flagged
+BLACK_LEVEL = 30.0  # mean grey level (0-255) below which a frame counts as black
+SATURATED = 250.0  # grey level of a saturated pixel
+RETRACE_SHARE = 0.9  # a row this saturated is a retrace line (torn frame)
+
+
+def inject(
+    frames: np.ndarray, rng: np.random.Generator, rate: float = BAD_FRAME_RATE
+) -> tuple[np.ndarray, np.ndarray, list[str | None]]:
+    """Corrupt about ``rate`` of ``frames`` ``(T, H, W, 3)`` uint8.
+
+    Returns the corrupted copy, ``(T,)`` bool ground-truth flags and the kind per frame.
+    """
+    if not 0.0 <= rate <= 1.0:
+        raise DeviceError(f"bad-frame rate must be in [0, 1], got {rate}")
+    out = np.array(frames, dtype=np.uint8, copy=True)
+    n, h, w = out.shape[:3]
+    flags = rng.random(n) < rate
+    kinds: list[str | None] = [None] * n
+    for t in np.flatnonzero(flags):  # a handful of frames: the corruption is per frame
+        kind = KINDS[rng.integers(len(KINDS))]
+        kinds[t] = kind
+        frame = out[t].astype(np.float32)
+        if kind == "black":
+            frame = 12.0 + 4.0 * rng.standard_normal(frame.shape[:2])[..., None]
+        elif kind == "noise_band":
+            for _ in range(rng.integers(1, 4)):
+                top = rng.integers(0, h)
+                height = max(2, int(h * rng.uniform(0.05, 0.2)))
+                band = frame[top : top + height]
+                snow = rng.normal(128.0, 70.0, band.shape[:2])[..., None]
+                frame[top : top + height] = 0.3 * band + 0.7 * snow
+        else:
+            row = rng.integers(h // 8, 7 * h // 8)
+            frame[row:] = np.roll(frame[row:], rng.integers(w // 6, w // 2), axis=1)
+            frame[row : row + 2] = 255.0  # saturated retrace line
+        out[t] = np.clip(frame, 0, 255).astype(np.uint8)
+    return out, flags, kinds
+
+
+def frame_features(frames: np.ndarray) -> np.ndarray:
+    """``(T, 3)`` per-frame scores: mean brightness, worst-row high-frequency energy above the
+    frame's median row, and the largest share of saturated pixels in a row (a retrace line)."""
+    gray = np.asarray(frames, np.float32).mean(axis=-1)  # (T, H, W)
+    row_hf = np.abs(np.diff(gray, axis=2)).mean(axis=2)  # (T, H)
+    band = np.percentile(row_hf, 95, axis=1) - np.median(row_hf, axis=1)
+    saturated_row = (gray >= SATURATED).mean(axis=2).max(axis=1)
+    return np.stack([gray.mean(axis=(1, 2)), band, saturated_row], axis=1)
+
+
+def detect(frames: np.ndarray, z_threshold: float = Z_THRESHOLD) -> np.ndarray:
+    """``(T,)`` bool: frames that look corrupted.
+
+    Black: mean brightness below :data:`BLACK_LEVEL`. Tear: a row more than
+    :data:`RETRACE_SHARE` saturated (the retrace line). Noise band: row snow energy more than
+    ``z_threshold`` robust standard deviations (median / MAD) above the sequence's level.
+    """
+    features = frame_features(frames)
+    band = features[:, 1]
+    median = np.median(band)
+    mad = 1.4826 * np.median(np.abs(band - median)) + 1e-3 * (abs(median) + 1.0)
+    return (
+        (features[:, 0] < BLACK_LEVEL)
+        | (features[:, 2] > RETRACE_SHARE)
+        | ((band - median) / mad > z_threshold)
+    )
+
+
+def precision_recall(truth: np.ndarray, flagged: np.ndarray) -> dict:
+    """Precision and recall of ``flagged`` against ``truth`` (both ``(T,)`` bool)."""
+    tp = int(np.sum(truth & flagged))
+    return {
+        "precision": tp / max(int(flagged.sum()), 1),
+        "recall": tp / max(int(truth.sum()), 1),
+        "injected": int(truth.sum()),
+        "flagged": int(flagged.sum()),
+    }

@@ -1,0 +1,43 @@
+"""Bad frames: injection rate and detector precision/recall on rendered fisheye frames."""
+
+import numpy as np
+import pytest
+
+from avatar_models.generator import generate
+from render_cams.fisheye import bad_frames
+from render_cams.fisheye.model import FisheyeModel
+from render_cams.fisheye.render import FisheyeRenderer
+from render_cams.fisheye.rig import camera_poses, controller_cameras
+from render_cams.scene import BodyScene
+
+
+@pytest.fixture(scope="module")
+def frames():
+    motion = generate("box", duration_s=1.5, fps=30)
+    poses = camera_poses(motion, controller_cameras())
+    with BodyScene(motion.skeleton) as scene:
+        renderer = FisheyeRenderer(scene, FisheyeModel.from_fov().scaled(0.2), face_size=64)
+        out = []
+        for t in range(motion.n_frames):
+            scene.update(motion, t)
+            out.append(renderer.render(poses[t, 0])[0])
+    return np.stack(out)
+
+
+def test_injection_rate_is_about_one_in_fifty():
+    blank = np.zeros((5000, 2, 2, 3), np.uint8)
+    _, flags, kinds = bad_frames.inject(blank, np.random.default_rng(0))
+    assert flags.mean() == pytest.approx(1 / 50, abs=0.005)
+    assert {k for k in kinds if k} == set(bad_frames.KINDS)
+
+
+def test_detector_precision_and_recall(frames):
+    truth, flagged = [], []
+    for seed in range(6):  # a raised rate gives enough corrupted frames to measure
+        corrupted, flags, _ = bad_frames.inject(frames, np.random.default_rng(seed), rate=0.15)
+        truth.append(flags)
+        flagged.append(bad_frames.detect(corrupted))
+    scores = bad_frames.precision_recall(np.concatenate(truth), np.concatenate(flagged))
+    assert scores["injected"] > 20
+    assert scores["precision"] >= 0.9 and scores["recall"] >= 0.9
+    assert not bad_frames.detect(frames).any()
