@@ -1,0 +1,160 @@
+"""``render_fisheye_sequence``: what the four controller cameras would record for a motion.
+
+Writes, under ``out_dir``:
+
+- ``<camera>/NNNNNN.png``: colour frames (``camera`` is e.g. ``left_controller-ring``), with
+  bad frames injected (ControllerPose §4.2, about 1 in 50) when ``bad_frame_rate > 0``;
+- ``<camera>/NNNNNN_range.png``: 16-bit range along each pixel's ray in millimetres (0 = none);
+- ``keypoints.json``: seed, camera models and one self-describing record per camera frame
+  (:mod:`render_cams.fisheye.records`), incl. the bad-frame ground truth;
+- ``fisheye.mp4``: the four cameras tiled 2x2, for a person to watch.
+
+Frames are rendered at the sensor's 30 Hz (ControllerPose §4.1 cameras); ``scale`` shrinks
+the 640x480 images for quick looks.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+import cv2
+import imageio.v2 as imageio
+import numpy as np
+
+from avatar_models import Motion
+from avatar_models.body import build_body
+from avatar_models.rigs import body17_positions
+from render_cams.device import DeviceError, motion_at_rate, resolve_seed
+from render_cams.fisheye import bad_frames
+from render_cams.fisheye.keypoints import (
+    DetectorNoise,
+    confidence,
+    joint_thickness,
+    project_joints,
+    visibility,
+    world_to_camera,
+)
+from render_cams.fisheye.model import FisheyeModel
+from render_cams.fisheye.records import frame_record
+from render_cams.fisheye.render import FisheyeRenderer
+from render_cams.fisheye.rig import camera_poses, check_cameras_outside, controller_cameras
+from render_cams.scene import BodyScene
+
+CAMERA_RATE_HZ = 30.0
+
+
+def render_fisheye_sequence(
+    motion: Motion,
+    out_dir: str | Path,
+    seed: int | np.random.Generator = 0,
+    model: FisheyeModel | None = None,
+    scale: float = 1.0,
+    rate_hz: float = CAMERA_RATE_HZ,
+    bad_frame_rate: float = bad_frames.BAD_FRAME_RATE,
+    detector_noise: DetectorNoise | None = None,
+    controllers: Sequence[str] = ("left_controller", "right_controller"),
+    video: bool = True,
+) -> dict:
+    """Render every controller camera over ``motion`` into ``out_dir``; return a summary
+    ``{"frames", "cameras", "fps_rendered", "bad_frames", "seed", "out_dir"}``.
+
+    Raises:
+        IntrinsicsError: impossible camera model; CameraInsideBodyError: a camera inside the
+        body; DeviceError: bad rate or scale; RigError: a skeleton without a body17 map.
+    """
+    seed = resolve_seed(seed)
+    if not (np.isfinite(scale) and 0.05 <= scale <= 4.0):
+        raise DeviceError(f"scale must be in [0.05, 4], got {scale}")
+    model = model or FisheyeModel.from_fov()
+    if scale != 1.0:
+        model = model.scaled(scale)
+    sampled = motion_at_rate(motion, rate_hz)
+    body = build_body(sampled.skeleton)
+    cameras = controller_cameras(controllers)
+    poses = camera_poses(sampled, cameras)  # (T, C, 4, 4)
+    check_cameras_outside(body, sampled, poses)
+    joints = body17_positions(sampled)  # (T, 17, 3)
+    thickness = joint_thickness(body)
+    rng_inject, rng_noise = (
+        np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2)
+    )
+
+    out = Path(out_dir)
+    names = [c.name.replace("/", "-") for c in cameras]
+    for name in names:
+        (out / name).mkdir(parents=True, exist_ok=True)
+    n_frames, n_cams = poses.shape[:2]
+    images = np.zeros((n_cams, n_frames, model.height, model.width, 3), np.uint8)
+    records: list[dict] = []
+    start = time.perf_counter()
+    with BodyScene(body) as scene:
+        renderer = FisheyeRenderer(scene, model)
+        for t in range(n_frames):  # rendering is inherently per frame
+            scene.update(sampled, t)
+            for c in range(n_cams):
+                color, range_m = renderer.render(poses[t, c])
+                images[c, t] = color
+                range_mm = np.clip(np.rint(range_m * 1000.0), 0, 65535).astype(np.uint16)
+                cv2.imwrite(str(out / names[c] / f"{t:06d}_range.png"), range_mm)
+                uv, in_image, joint_range = project_joints(
+                    model, poses[t, c][None], joints[t][None]
+                )
+                vis = visibility(uv[0], in_image[0], joint_range[0], range_m, thickness)
+                records.append((t, c, uv[0], in_image[0], vis))
+    elapsed = time.perf_counter() - start
+
+    truth = np.zeros((n_cams, n_frames), bool)
+    for c in range(n_cams):
+        images[c], truth[c], _ = bad_frames.inject(images[c], rng_inject, bad_frame_rate)
+        for t in range(n_frames):
+            cv2.imwrite(str(out / names[c] / f"{t:06d}.png"), images[c, t][..., ::-1])
+    w2c = world_to_camera(poses)
+    frames_json = []
+    for t, c, uv, in_image, vis in records:
+        conf = confidence(model, uv, vis)
+        if detector_noise is not None:
+            uv, detected, conf = detector_noise.apply(uv, vis, conf, rng_noise)
+            in_image = in_image & detected
+        frames_json.append(
+            frame_record(
+                names[c],
+                model,
+                t,
+                t / rate_hz,
+                w2c[t, c],
+                joints[t],
+                uv,
+                in_image,
+                vis,
+                conf,
+                bad_frame=bool(truth[c, t]),
+            )
+        )
+    flagged = np.stack([bad_frames.detect(images[c]) for c in range(n_cams)])
+    summary = {
+        "frames": int(n_frames),
+        "cameras": names,
+        "fps": rate_hz,
+        "fps_rendered": n_frames * n_cams / max(elapsed, 1e-9),
+        "bad_frames": bad_frames.precision_recall(truth.ravel(), flagged.ravel()),
+        "seed": seed,
+        "model": model.as_dict(),
+        "out_dir": str(out),
+    }
+    (out / "keypoints.json").write_text(json.dumps({**summary, "records": frames_json}))
+    if video:
+        tiled = np.concatenate(
+            [np.concatenate(list(images[r : r + 2]), axis=2) for r in range(0, n_cams, 2)], axis=1
+        )
+        # Even sizes for H.264.
+        imageio.mimwrite(
+            out / "fisheye.mp4",
+            tiled[:, : tiled.shape[1] // 2 * 2, : tiled.shape[2] // 2 * 2],
+            fps=rate_hz,
+            macro_block_size=1,
+        )
+        summary["video"] = str(out / "fisheye.mp4")
+    return summary
