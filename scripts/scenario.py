@@ -15,6 +15,8 @@ A scenario names a motion source, the body, the stages to run and pass/fail thre
     picture_frames = 6
     [thresholds]              # metric = max allowed, or {min = x} / {max = x}
     replay_error_mm_max = 1.0
+    [physics]                 # sim.thresholds.CheckConfig overrides (definitions, thresholds)
+    skate_cm_s_median = 40.0
 
 Unknown keys, wrong types and impossible values raise :class:`ScenarioError` naming the key.
 """
@@ -87,6 +89,7 @@ class Scenario:
     body: BodySpec = field(default_factory=BodySpec)
     report: ReportSpec = field(default_factory=ReportSpec)
     thresholds: dict[str, Threshold] = field(default_factory=dict)
+    physics: dict[str, float] = field(default_factory=dict)
     path: str | None = None
 
 
@@ -128,7 +131,7 @@ def _threshold(name: str, raw: Any) -> Threshold:
 
 def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
     """Validate a parsed TOML table into a :class:`Scenario`."""
-    top = {"name", "seed", "motion", "body", "report", "thresholds"}
+    top = {"name", "seed", "motion", "body", "report", "thresholds", "physics"}
     unknown = sorted(set(data) - top)
     if unknown:
         raise ScenarioError(f"unknown top-level key(s) {unknown}; allowed: {sorted(top)}")
@@ -147,6 +150,9 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
     if not isinstance(thresholds_raw, dict):
         raise ScenarioError("[thresholds] must be a table")
     thresholds = {k: _threshold(k, v) for k, v in thresholds_raw.items()}
+    physics = data.get("physics", {})
+    if not isinstance(physics, dict):
+        raise ScenarioError("[physics] must be a table of check settings")
     return Scenario(
         name=_check_type(data.get("name", "scenario"), str, "name"),
         seed=_check_type(data.get("seed", 0), int, "seed"),
@@ -154,6 +160,7 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
         body=body,
         report=report,
         thresholds=thresholds,
+        physics=physics,
         path=path,
     )
 

@@ -1,0 +1,6 @@
+"""Scenario stages. Each module has ``METRICS`` (name -> meaning) and ``run(ctx)``; the order
+of :data:`STAGES` is the data flow of ARCHITECTURE.md."""
+
+from scripts.stages import body, motion, physics, pictures
+
+STAGES = (motion, body, physics, pictures)
