@@ -18,18 +18,18 @@ both the anatomical and the recorded range are thresholded.
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from avatar_models import Skeleton
 from avatar_models.body.anatomy import classify
 from avatar_models.body.joint_ranges import euler_order
 from avatar_models.rigs import RigError, identify_rig
+from synthesis.coolmoves.rotations import euler_axes, from_euler, to_euler
 
 _DEFAULT_ORDER = "XYZ"
 
 
 class JointLimits:
-    """Clamp local rotations to a skeleton's joint limits, vectorised per Euler order."""
+    """Clamp local rotations to a skeleton's joint limits, all joints in one vectorised pass."""
 
     def __init__(self, skeleton: Skeleton, widen_to: np.ndarray | None = None):
         """``widen_to``: optional ``(P, J, 4)`` poses whose angles every range must include."""
@@ -38,46 +38,36 @@ class JointLimits:
             roles = classify(skeleton, rig).roles
         except RigError:
             roles = {}
-        groups: dict[str, list[int]] = {}
+        joints, orders, pairs = [], [], []
         for name in skeleton.limits:
             j = skeleton.index(name)
             role = roles.get(j)
-            order = euler_order(role) if role not in (None, "root") else _DEFAULT_ORDER
-            groups.setdefault(order, []).append(j)
-        self.groups: list[tuple[str, np.ndarray, np.ndarray, np.ndarray]] = []
-        for order, joints in groups.items():
-            bounds = np.array(
-                [
-                    [
-                        skeleton.limits[skeleton.names[j]].get(f"r{a.lower()}", (-np.pi, np.pi))
-                        for a in order
-                    ]
-                    for j in joints
-                ]
-            )  # (G, 3 axes, lo/hi)
-            lo, hi = bounds[..., 0], bounds[..., 1]
-            if widen_to is not None and len(widen_to):
-                angles = _euler(np.asarray(widen_to)[:, joints], order)  # (P, G, 3)
-                lo, hi = np.minimum(lo, angles.min(axis=0)), np.maximum(hi, angles.max(axis=0))
-            self.groups.append((order, np.array(joints), lo, hi))
+            joints.append(j)
+            orders.append(euler_order(role) if role not in (None, "root") else _DEFAULT_ORDER)
+            pairs.append((skeleton.limits[name], orders[-1]))
+        # All limited joints at once, each with its own Euler order: one pass per call.
+        self.joints = np.array(joints, dtype=np.int64)
+        self.axes = euler_axes(orders) if joints else np.zeros((0, 3), np.int64)
+        bounds = np.array(
+            [[r.get(f"r{a.lower()}", (-np.pi, np.pi)) for a in order] for r, order in pairs]
+        ).reshape(len(joints), 3, 2)  # (G, 3 axes, lo/hi)
+        self.lo, self.hi = bounds[..., 0], bounds[..., 1]
+        if widen_to is not None and len(widen_to) and joints:
+            angles = to_euler(np.asarray(widen_to)[:, self.joints], self.axes)  # (P, G, 3)
+            self.lo = np.minimum(self.lo, angles.min(axis=0))
+            self.hi = np.maximum(self.hi, angles.max(axis=0))
 
     def clamp(self, local_rot: np.ndarray) -> np.ndarray:
         """``local_rot (..., J, 4)`` wxyz with every limited joint inside its ranges."""
         out = np.array(local_rot, dtype=float)
-        for order, joints, lo, hi in self.groups:
-            q = out[..., joints, :]
-            angles = _euler(q, order)
-            clipped = np.clip(angles, lo, hi)
-            changed = np.any(clipped != angles, axis=-1)
-            if not np.any(changed):
-                continue
-            xyzw = Rotation.from_euler(order, clipped.reshape(-1, 3)).as_quat()
-            rebuilt = xyzw[:, [3, 0, 1, 2]].reshape(q.shape)
-            out[..., joints, :] = np.where(changed[..., None], rebuilt, q)
+        if not self.joints.size:
+            return out
+        q = out[..., self.joints, :]
+        angles = to_euler(q, self.axes)
+        clipped = np.clip(angles, self.lo, self.hi)
+        changed = np.any(clipped != angles, axis=-1)
+        if np.any(changed):
+            out[..., self.joints, :] = np.where(
+                changed[..., None], from_euler(clipped, self.axes), q
+            )
         return out
-
-
-def _euler(q: np.ndarray, order: str) -> np.ndarray:
-    """``(..., 4)`` wxyz -> ``(..., 3)`` intrinsic Euler angles in ``order``."""
-    angles = Rotation.from_quat(q.reshape(-1, 4)[:, [1, 2, 3, 0]]).as_euler(order)
-    return angles.reshape(*q.shape[:-1], 3)

@@ -39,6 +39,7 @@ from synthesis.coolmoves.database import Database
 from synthesis.coolmoves.features import search_vectors, sliding_windows
 from synthesis.coolmoves.knn import K_NEIGHBOURS, MAX_DISTANCE, KNNMatcher
 from synthesis.coolmoves.limits import JointLimits
+from synthesis.coolmoves.rotations import to_matrix
 from synthesis.coolmoves.smoothing import ewma, ewma_step
 
 _Z = np.array([0.0, 0.0, 1.0])
@@ -185,7 +186,7 @@ class CoolMoves(Synthesizer):
         Forward kinematics along the root-to-head chain only, on the rig scaled by ``scale``.
         """
         ref = self.database.skeleton
-        mats = quat.to_matrix(rotations[:, self._head_chain])  # (B, L, 3, 3), one scipy call
+        mats = to_matrix(rotations[:, self._head_chain])  # (B, L, 3, 3)
         glob = mats[:, 0]
         pos = np.zeros((rotations.shape[0], 3))
         for link, j in enumerate(self._head_chain[1:], start=1):
