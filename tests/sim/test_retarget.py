@@ -1,0 +1,74 @@
+"""Retargeting onto the humanoid: own rig exactly, other sizes and real mocap under 2 cm."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from avatar_models.body import build_body
+from avatar_models.errors import MotionValueError
+from avatar_models.formats import load_motion
+from avatar_models.generator import Subject, generate
+from avatar_models.rigs import body17_positions
+from sim.retarget import fitted_body, retarget
+
+BANDAI_WALK = "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh"
+
+
+def test_own_rig_is_reproduced():
+    motion = generate("walk", duration_s=1.0, fps=30.0)
+    body = build_body(motion.skeleton)
+    qpos, out, residual_cm = retarget(motion, body)
+    assert residual_cm.max() < 0.1  # 1 mm
+    np.testing.assert_allclose(body17_positions(out), body17_positions(motion), atol=2e-3)
+    assert qpos.shape == (motion.n_frames, 7 + len(body.hinges))
+
+
+def test_other_size_avatar_fits_its_own_size():
+    """A tall subject on the avatar rig: the fitted body takes its size, residual ~0."""
+    motion = generate("walk", Subject(height_m=1.95), duration_s=1.0, fps=30.0)
+    body = fitted_body(motion)
+    assert body.stature == pytest.approx(1.95, rel=0.03)
+    assert retarget(motion).residual_cm.mean() < 0.1
+
+
+def test_given_body_scales_the_targets():
+    motion = generate("walk", Subject(height_m=1.95), duration_s=0.5, fps=30.0)
+    small = build_body(generate("walk", duration_s=0.1).skeleton, height_m=1.6)
+    _, out, residual_cm = retarget(motion, small)
+    assert residual_cm.mean() < 0.5
+    ratio = np.ptp(body17_positions(out)[..., 2]) / np.ptp(body17_positions(motion)[..., 2])
+    assert ratio == pytest.approx(1.6 / 1.95, rel=0.05)
+
+
+def test_joint_limits_hold(mocap_dir):
+    motion = load_motion(mocap_dir / "cmu" / "09_01.bvh")[::4]
+    body = fitted_body(motion)
+    qpos, _, _ = retarget(motion, body)
+    ranges = np.array([body.hinge_ranges[j][a] for j, a in body.hinges])
+    assert np.all(qpos[:, 7:] >= ranges[:, 0] - 1e-6)
+    assert np.all(qpos[:, 7:] <= ranges[:, 1] + 1e-6)
+
+
+def test_rig_without_body17_is_refused():
+    from avatar_models.motion import Motion
+    from avatar_models.skeleton import Skeleton
+
+    sk = Skeleton(["a", "b"], [-1, 0], np.array([[0, 0, 1.0], [0, 0, 0.5]]), name="blob")
+    motion = Motion(sk, 30.0, np.zeros((2, 3)), np.tile([1.0, 0, 0, 0], (2, 2, 1)))
+    with pytest.raises(MotionValueError, match="cannot retarget"):
+        retarget(motion)
+
+
+@pytest.mark.mocap
+@pytest.mark.parametrize(
+    "clip", ["cmu/16_35.bvh", "cmu/06_06.bvh", BANDAI_WALK], ids=["cmu_run", "cmu_bball", "bandai"]
+)
+def test_real_mocap_retargets_under_2cm(mocap_dir, clip):
+    motion = load_motion(mocap_dir / clip)
+    motion = motion[1::2] if motion.fps > 60 else motion  # frame 0 of CMU is a T-pose
+    _, out, residual_cm = retarget(motion)
+    p95 = np.percentile(residual_cm, 95)
+    print(f"{clip}: residual mean {residual_cm.mean():.2f} cm, p95 {p95:.2f} cm")
+    assert residual_cm.mean() < 2.0
+    assert out.skeleton.name == "avatar"
