@@ -65,12 +65,16 @@ class KinectDepthCamera:
         """Noise-free ``(H, W)`` depth in metres (0 = no hit, no range limit) and ``(H, W)``
         int32 part labels (0 background, > 0 body) of the scene as posed now."""
         s = self.sensor
-        parts = scene.render_parts(self.camera_to_world, s.K, s.width, s.height)
-        # BodyScene.render draws colour too; a depth-only pass through the same (already
-        # placed) camera and renderer is about twice as fast.
+        # Two passes through BodyScene's camera and renderer (BodyScene.render draws colour
+        # too, render_parts drops the depth): segmentation, which draws only the body and
+        # without multisampling, gives the labels and the body's depth under them; a
+        # depth-only pass gives the rest of the scene.
+        scene._place_camera(self.camera_to_world, s.K)
         renderer = scene._renderer_of_size(s.width, s.height)
+        seg, body_depth = renderer.render(scene.scene, pyrender.RenderFlags.SEG, scene._seg_map)
+        parts = seg[..., 0].astype(np.int32) + 256 * seg[..., 1].astype(np.int32)
         depth = renderer.render(scene.scene, pyrender.RenderFlags.DEPTH_ONLY)
-        return depth.astype(float), parts
+        return np.where(parts > 0, body_depth, depth).astype(float), parts
 
     def capture(self, scene: BodyScene, rng: np.random.Generator) -> DepthFrame:
         """The depth frame and body-index map the sensor records of ``scene`` as posed now."""
