@@ -16,6 +16,8 @@ BENCHMARKS: dict[str, str] = {
     "formats": "formats",
     "checks": "checks",
     "coolmoves": "coolmoves",
+    "cameras": "cameras",
+    "kinect": "kinect",
 }
 
 

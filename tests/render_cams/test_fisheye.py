@@ -39,12 +39,15 @@ def test_paper_fov_and_intrinsics_round_trip():
     assert np.abs(ours[:, :2] / ours[:, 2:] - xy).max() < 1e-6
 
 
-def test_project_equals_opencv():
-    model = FisheyeModel.from_fov(D=D_TEST)
-    points = np.random.default_rng(0).uniform([-2, -2, 0.05], [2, 2, 3], size=(500, 3))
-    ours, _ = model.project(points)
-    cv, _ = cv2.fisheye.projectPoints(points[:, None], np.zeros(3), np.zeros(3), model.K, model.D)
-    assert np.abs(ours - cv[:, 0]).max() < 1e-9
+def test_equidistant_projection_is_f_theta():
+    model = FisheyeModel.from_fov(D=(0.0, 0.0, 0.0, 0.0))
+    theta = np.radians([0.0, 20.0, 45.0, 70.0])
+    points = np.stack([np.sin(theta), np.zeros(4), np.cos(theta)], axis=1)  # along +x
+    uv, ok = model.project(points)
+    assert ok.all()
+    np.testing.assert_allclose(uv[:, 0] - model.K[0, 2], model.K[0, 0] * theta, atol=1e-9)
+    _, behind = model.project(np.array([[0.1, 0.0, -1.0]]))
+    assert not behind[0]
 
 
 @pytest.mark.parametrize(
