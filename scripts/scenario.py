@@ -58,6 +58,7 @@ class BodySpec:
 @dataclass(frozen=True)
 class ReportSpec:
     picture_frames: int = 6
+    strip_span_s: float = 1.2  # the strip spans about one stride, so the frames differ
     gif: bool = True
     gif_fps: float = 15.0
 
@@ -144,6 +145,8 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
         raise ScenarioError(f"motion.height_m={motion.height_m} is not a human height in metres")
     if body.mass_kg is not None and body.mass_kg <= 0:
         raise ScenarioError("body.mass_kg must be positive")
+    if report.strip_span_s <= 0:
+        raise ScenarioError("report.strip_span_s must be positive")
     if report.picture_frames < 1:
         raise ScenarioError("report.picture_frames must be at least 1")
     thresholds_raw = data.get("thresholds", {})

@@ -16,7 +16,7 @@ def render_frames(
     width: int = 320,
     height: int = 400,
     distance: float = 3.2,
-    azimuth: float = 120.0,
+    azimuth: float = 150.0,
     elevation: float = -12.0,
 ) -> np.ndarray:
     """Render ``qpos[frame_ids]`` from a camera that follows the root at a fixed offset."""

@@ -77,8 +77,28 @@ def _model_without_exclusions(desc: BodyDescription) -> ET.Element:
         rgb2="0.3 0.4 0.5",
     )
     ET.SubElement(asset, "material", name="grid", texture="grid", texrepeat="8 8")
+    ET.SubElement(
+        asset,
+        "texture",
+        name="sky",
+        type="skybox",
+        builtin="gradient",
+        width="256",
+        height="256",
+        rgb1="0.55 0.65 0.75",
+        rgb2="0.1 0.12 0.15",
+    )
     world = ET.SubElement(root, "worldbody")
-    ET.SubElement(world, "light", name="sun", pos="0 0 5", dir="0 0 -1", directional="true")
+    ET.SubElement(
+        world,
+        "light",
+        name="sun",
+        pos="0 0 5",
+        dir="0 0 -1",
+        directional="true",
+        diffuse="0.4 0.4 0.4",
+        castshadow="false",
+    )
     ET.SubElement(world, "geom", name="floor", type="plane", size="0 0 0.05", material="grid")
 
     rest = sk.rest_positions()
@@ -91,6 +111,18 @@ def _model_without_exclusions(desc: BodyDescription) -> ET.Element:
                 world, "body", name=sk.names[0], pos=_fmt([0, 0, desc.root_height])
             )
             ET.SubElement(body, "freejoint", name="root")
+            # A light that follows the body, so renders keep a lit subject and its shadow
+            # wherever it walks (the directional "sun" alone leaves it dark far from the origin).
+            ET.SubElement(
+                body,
+                "light",
+                name="follow",
+                mode="trackcom",
+                pos="1.5 -1.5 3",
+                dir="-0.4 0.4 -1",
+                diffuse="0.6 0.6 0.6",
+                castshadow="true",
+            )
         else:
             body = ET.SubElement(
                 bodies[int(sk.parents[j])], "body", name=sk.names[j], pos=_fmt(sk.offsets[j])

@@ -15,7 +15,8 @@ METRICS: dict[str, str] = {}
 def run(ctx: RunContext) -> None:
     spec = ctx.scenario.report
     n = ctx.qpos.shape[0]
-    strip_ids = np.linspace(0, n - 1, spec.picture_frames).round().astype(int)
+    last = min(n - 1, int(round(spec.strip_span_s * ctx.motion.fps)))
+    strip_ids = np.linspace(0, last, spec.picture_frames).round().astype(int)
     strip = np.hstack(render_frames(ctx.model, ctx.qpos, strip_ids))
     ctx.output(
         "strip_png",
