@@ -1,0 +1,59 @@
+"""Kinect simulation throughput next to the sensors' real 30 fps.
+
+Rows: depth frames/s (render + noise + body index) for Kinect V2 (512 x 424) and Azure Kinect
+NFOV (640 x 576), and skeleton frames/s (joints, tracking state, noise) on a 10 s clip.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from avatar_models.generator import generate
+from render_cams.kinect import default_sensor_pose, kinect_skeleton
+from render_cams.kinect.depth import KinectDepthCamera
+from render_cams.kinect.sensors import KINECT_RATE_HZ
+from render_cams.scene import BodyScene
+from scripts.benchmarks import BenchRow, best_of
+
+_SENSOR_RATE = "sensor's own rate"
+
+
+def run(quick: bool = False) -> list[BenchRow]:
+    """Depth and skeleton rows; see the module docstring."""
+    motion = generate("box", duration_s=2.0 if quick else 10.0, fps=30.0, seed=0)
+    pose = default_sensor_pose(motion)
+    frames = 10 if quick else 60
+    rows = []
+    with BodyScene(motion.skeleton) as scene:
+        for device in ("kinect-v2", "azure-kinect"):
+            camera = KinectDepthCamera(device, pose)
+            rng = np.random.default_rng(0)
+
+            def record(camera=camera, rng=rng) -> None:
+                for t in range(frames):
+                    scene.update(motion, t)
+                    camera.capture(scene, rng)
+
+            seconds = best_of(record, 2 if quick else 3)
+            rows.append(
+                BenchRow(
+                    f"kinect_depth[{device}]",
+                    "frames/s",
+                    frames / seconds,
+                    KINECT_RATE_HZ,
+                    _SENSOR_RATE,
+                    f"{camera.sensor.width}x{camera.sensor.height}, render + noise + body index",
+                )
+            )
+    seconds = best_of(lambda: kinect_skeleton(motion, "azure-kinect", pose), 3)
+    rows.append(
+        BenchRow(
+            "kinect_skeleton[azure-kinect]",
+            "frames/s",
+            motion.n_frames / seconds,
+            KINECT_RATE_HZ,
+            _SENSOR_RATE,
+            f"{motion.n_frames} frames x 32 joints, occlusion + noise",
+        )
+    )
+    return rows
