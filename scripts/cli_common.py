@@ -61,3 +61,23 @@ def unit_option(unit: str | None) -> dict[str, Any]:
         return {"unit": float(unit)}
     except ValueError:
         return {"unit": unit}
+
+
+BUILTIN_PREFIX = "builtin:"
+
+
+def load_motion_arg(arg: str, unit: str | None = None, seed: int = 0, duration_s: float = 4.0):
+    """A motion file path, or ``builtin:ACTIVITY`` for the built-in generator (any command
+    that takes a MOTION accepts both)."""
+    if arg.startswith(BUILTIN_PREFIX):
+        from avatar_models.generator import ACTIVITIES, generate
+
+        activity = arg[len(BUILTIN_PREFIX) :]
+        if activity not in ACTIVITIES:
+            raise AvatarsimError(
+                f"unknown built-in activity {activity!r}; built-in: {', '.join(ACTIVITIES)}"
+            )
+        return generate(activity, duration_s=duration_s, seed=seed)
+    from avatar_models.formats import load_motion
+
+    return load_motion(Path(arg), **unit_option(unit))
