@@ -22,6 +22,7 @@ before the first tracked sample the avatar stands in its rest pose at the origin
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,7 +33,7 @@ from avatar_models.body import build_body
 from avatar_models.body.ik import HumanoidIK, IKSettings, humanoid_model, motion_from_qpos
 from avatar_models.measure import standing_height
 from render_cams import TrackingStream
-from render_cams.vr import HEADSET_AND_CONTROLLERS, nominal_attachment
+from render_cams.vr import HEADSET_AND_CONTROLLERS, Attachment, nominal_attachment
 from synthesis.base import Pose, SynthesisError, Synthesizer, TrackingFrame, on_clock
 
 STEERED_SITES = ("head", "l_wrist", "r_wrist", "pelvis", "l_ankle", "r_ankle")
@@ -105,6 +106,11 @@ class IKBaseline(Synthesizer):
             the evaluation's rig so errors are measured on the same joints as other methods.
         user_height_m: the user's standing height (as :func:`standing_height` measures it);
             None keeps the skeleton's size.
+        calibration: the device-on-joint attachments of the user (hmd, left, right
+            controller), as a calibration would find them; default: the nominal attachments
+            on ``skeleton``. Only their positions are used when ``follow_orientation`` is off.
+        follow_orientation: steer head and hand orientations too. Turn it off when the
+            calibration comes from another rig, whose joint frames differ from the humanoid's.
         iterations_per_tick: QP iterations per tick after the first.
     """
 
@@ -114,6 +120,8 @@ class IKBaseline(Synthesizer):
         self,
         skeleton: Skeleton,
         user_height_m: float | None = None,
+        calibration: Sequence[Attachment] | None = None,
+        follow_orientation: bool = True,
         iterations_per_tick: int = ITERATIONS_PER_TICK,
     ):
         if user_height_m is not None:
@@ -124,12 +132,16 @@ class IKBaseline(Synthesizer):
             humanoid_model(self.body),
             STEERED_SITES,
             position_cost=POSITION_COST,
-            orientation_cost=ORIENTATION_COST,
+            orientation_cost=ORIENTATION_COST if follow_orientation else 0.0,
             settings=IKSettings(max_iterations=self.iterations_per_tick),
         )
-        self._attachments = [
-            nominal_attachment(d, self.body.skeleton) for d in HEADSET_AND_CONTROLLERS
-        ]
+        self._attachments = (
+            list(calibration)
+            if calibration is not None
+            else [nominal_attachment(d, self.body.skeleton) for d in HEADSET_AND_CONTROLLERS]
+        )
+        if len(self._attachments) != len(HEADSET_AND_CONTROLLERS):
+            raise SynthesisError("the calibration needs one attachment per hmd and controller")
         rest = self.ik.frame_positions(self.ik.posture)
         self._rest_head_to_pelvis = rest[3] - rest[0]
         self._rest_pelvis_to_feet = rest[4:] - rest[3]
