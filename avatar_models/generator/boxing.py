@@ -14,8 +14,9 @@ import numpy as np
 
 from avatar_models.generator.curves import keyframes
 from avatar_models.generator.feet import FootGeometry, planted
+from avatar_models.generator.ik import axis_rotation
 from avatar_models.generator.plan import LimbTarget, Plan, Scene
-from avatar_models.generator.poses import gaze, heading_rotation, trunk
+from avatar_models.generator.poses import Y_AXIS, gaze, heading_rotation, trunk
 
 STANCE_YAW = np.radians(-20.0)
 
@@ -28,6 +29,10 @@ def _pose(
     return np.array([*left, *right, twist, dip, *left_pole, *right_pole], dtype=float)
 
 
+# Jab and hook end with the palm down and the elbow turned up and out (the hook swings with
+# the elbow at shoulder height): that pole keeps the humerus within its internal rotation
+# range (70 deg, AAOS); an elbow pointing down would need about 150.
+ELBOW_OUT = (0.0, 1.0, 1.0)
 GUARD = _pose((0.30, 0.10, 1.45), (0.20, -0.10, 1.47))
 # Each punch: (duration at tempo 1 in seconds, key fractions, key poses) from guard to guard.
 PUNCHES = {
@@ -36,8 +41,8 @@ PUNCHES = {
         (0.0, 0.35, 0.5, 1.0),
         (
             GUARD,
-            _pose((0.70, 0.04, 1.42), (0.20, -0.10, 1.47), -0.15, 0.0, (0.0, 0.5, -1.0)),
-            _pose((0.70, 0.04, 1.42), (0.20, -0.10, 1.47), -0.15, 0.0, (0.0, 0.5, -1.0)),
+            _pose((0.70, 0.04, 1.42), (0.20, -0.10, 1.47), -0.15, 0.0, ELBOW_OUT),
+            _pose((0.70, 0.04, 1.42), (0.20, -0.10, 1.47), -0.15, 0.0, ELBOW_OUT),
             GUARD,
         ),
     ),
@@ -46,9 +51,9 @@ PUNCHES = {
         (0.0, 0.3, 0.55, 0.7, 1.0),
         (
             GUARD,
-            _pose((0.25, 0.32, 1.40), (0.20, -0.10, 1.47), 0.15, 0.02),
-            _pose((0.45, -0.02, 1.45), (0.20, -0.12, 1.47), -0.5, 0.02, (0.0, 1.0, 0.6)),
-            _pose((0.45, -0.02, 1.45), (0.20, -0.12, 1.47), -0.5, 0.02, (0.0, 1.0, 0.6)),
+            _pose((0.25, 0.32, 1.40), (0.20, -0.10, 1.47), 0.15, 0.02, ELBOW_OUT),
+            _pose((0.45, -0.02, 1.45), (0.20, -0.12, 1.47), -0.5, 0.02, ELBOW_OUT),
+            _pose((0.45, -0.02, 1.45), (0.20, -0.12, 1.47), -0.5, 0.02, ELBOW_OUT),
             GUARD,
         ),
     ),
@@ -59,10 +64,10 @@ PUNCHES = {
             GUARD,
             _pose((0.30, 0.10, 1.45), (0.25, -0.15, 1.15), 0.1, 0.06),
             _pose(
-                (0.30, 0.12, 1.45), (0.45, -0.02, 1.55), 0.45, -0.02, right_pole=(-0.2, -0.3, -1.0)
+                (0.30, 0.12, 1.45), (0.45, -0.02, 1.55), 0.45, -0.02, right_pole=(0.0, -0.5, -1.0)
             ),
             _pose(
-                (0.30, 0.12, 1.45), (0.45, -0.02, 1.55), 0.45, -0.02, right_pole=(-0.2, -0.3, -1.0)
+                (0.30, 0.12, 1.45), (0.45, -0.02, 1.55), 0.45, -0.02, right_pole=(0.0, -0.5, -1.0)
             ),
             GUARD,
         ),
@@ -110,11 +115,18 @@ def box(scene: Scene) -> Plan:
     root_pos = np.column_stack(
         [np.zeros(n), np.full(n, -0.01 * height), root_z - bounce - pose[:, 7] * scale]
     )
-    # Hand heights follow the crouch and bounce of the body.
-    root = np.column_stack([root_pos[:, :2], root_pos[:, 2] - scene.skeleton.offsets[0, 2]])
+    # Hands follow the crouch and bounce of the body, and lean with a stooping style's trunk
+    # (about the pelvis): the guard is held in front of the chest, not at a fixed height.
+    root_rot = heading_rotation(STANCE_YAW, n)
+    lean = root_rot[0] @ axis_rotation(Y_AXIS, [np.radians(scene.style.stoop_deg)])[0]
+    lean = lean @ root_rot[0].T
+    rest_root = scene.skeleton.offsets[0]
+
+    def hand_target(rel: np.ndarray) -> np.ndarray:
+        return root_pos + (rel * scale - rest_root) @ lean.T
     plan = Plan(
         root_pos=root_pos,
-        root_rot=heading_rotation(STANCE_YAW, n),
+        root_rot=root_rot,
         pelvis=scene.constant(np.eye(3)),
         spine=trunk(scene, np.radians(8.0), np.radians(12.0) + pose[:, 6]),
         head=gaze(scene, 0.0, np.radians(10.0)),
@@ -124,8 +136,8 @@ def box(scene: Scene) -> Plan:
             for (side, ft), sg in zip(feet.items(), (1, -1), strict=True)
         },
         arms={
-            "L": LimbTarget(root + left * scale, pose[:, 8:11]),
-            "R": LimbTarget(root + right * scale, pose[:, 11:14]),
+            "L": LimbTarget(hand_target(left), pose[:, 8:11]),
+            "R": LimbTarget(hand_target(right), pose[:, 11:14]),
         },
         fist=np.ones((n, 2)),
         meta={"punches": names},

@@ -6,6 +6,7 @@ All functions are vectorised: ``u`` is any array of normalised times, output has
 from __future__ import annotations
 
 import numpy as np
+from scipy.ndimage import maximum_filter1d
 
 
 def smoothstep(u: np.ndarray) -> np.ndarray:
@@ -66,3 +67,21 @@ def keyframes(times: np.ndarray, key_times: np.ndarray, key_values: np.ndarray) 
     u = (times - key_times[seg]) / (key_times[seg + 1] - key_times[seg])
     s = minimum_jerk(u).reshape((-1,) + (1,) * (key_values.ndim - 1))
     return key_values[seg] * (1.0 - s) + key_values[seg + 1] * s
+
+
+def smooth_cap(values: np.ndarray, cap: np.ndarray, fps: float, half_width_s: float) -> np.ndarray:
+    """``values (T,)`` lowered smoothly so that they never exceed ``cap (T,)``.
+
+    The needed drop ``max(values - cap, 0)`` is first dilated (running maximum over
+    ``+-half_width_s``), then averaged with a Hann window of the same half-width. Every value
+    in the window is at least the drop at its centre, so the result stays under ``cap``; and
+    a Hann window is C1, so its convolution with the (stepwise) dilated drop is C2: continuous
+    velocity and acceleration, unlike ``np.minimum(values, cap)`` whose kinks are
+    accelerations of many g for a body whose pelvis is clamped to its leg reach.
+    """
+    drop = np.maximum(values - cap, 0.0)
+    half = max(int(round(half_width_s * fps)), 1)
+    dilated = maximum_filter1d(drop, 2 * half + 1, mode="nearest")
+    kernel = np.hanning(2 * half + 3)[1:-1]
+    padded = np.pad(dilated, half, mode="edge")
+    return values - np.convolve(padded, kernel / kernel.sum(), mode="valid")

@@ -14,10 +14,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from avatar_models.generator.bounce import spring_mass_bounce, vaulting_bob
+from avatar_models.generator.curves import smooth_cap
 from avatar_models.generator.feet import gait_track, pelvis_height_limit
 from avatar_models.generator.ik import euler
 from avatar_models.generator.plan import LimbTarget, Plan, Scene
 from avatar_models.generator.poses import arm_angles, gaze, heading_rotation, trunk
+from avatar_models.generator.standing import CAP_HALF_WIDTH_S
 
 TAU = 2.0 * np.pi
 
@@ -92,15 +95,17 @@ def _gait_plan(scene: Scene, gait: Gait) -> tuple[Plan, np.ndarray]:
         [speed * t - start_x, 0.02 * height * np.cos(mid_stance) * (1 - gait.running)], 1
     )
     rest_z = scene.skeleton.offsets[0, 2]
-    bob = gait.bob * height * style.amplitude * np.cos(2 * mid_stance)
-    nominal = (
-        rest_z
-        - (gait.crouch + style.knee_bend) * scene.leg_length
-        + np.where(gait.running, -bob, bob)
-    )
+    if gait.running:
+        step_phase = (2.0 * phase_l) % 1.0  # 0 at each touchdown
+        bob = spring_mass_bounce(step_phase, 0.5 / frequency, 2.0 * gait.duty)
+    else:
+        bob = vaulting_bob(mid_stance, gait.bob * height * style.amplitude, 2.0 * frequency)
+    nominal = rest_z - (gait.crouch + style.knee_bend) * scene.leg_length + bob
     ankles = np.stack([tr.ankle for tr in tracks], axis=1)
     limit = pelvis_height_limit(scene, root_xy, root_rot @ pelvis, ankles)
-    root_pos = np.column_stack([root_xy, np.minimum(nominal, limit)])
+    root_pos = np.column_stack(
+        [root_xy, smooth_cap(nominal, limit, scene.fps, CAP_HALF_WIDTH_S)]
+    )
 
     joints = {}
     for side, tr in zip("LR", tracks, strict=True):

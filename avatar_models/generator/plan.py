@@ -54,6 +54,10 @@ class Scene:
         return self.times.size
 
     @property
+    def fps(self) -> float:
+        return 1.0 / (self.times[1] - self.times[0]) if self.n_frames > 1 else 1.0
+
+    @property
     def style(self) -> Style:
         return self.subject.effect
 
@@ -130,8 +134,7 @@ def _finger_rotations(scene: Scene, fist: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def _motion(scene: Scene, plan: Plan, local: np.ndarray) -> Motion:
-    fps = 1.0 / (scene.times[1] - scene.times[0]) if scene.n_frames > 1 else 1.0
-    return Motion(scene.skeleton, fps, plan.root_pos, quat.from_matrix(local))
+    return Motion(scene.skeleton, scene.fps, plan.root_pos, quat.from_matrix(local))
 
 
 def realise(scene: Scene, plan: Plan) -> Motion:

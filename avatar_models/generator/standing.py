@@ -4,8 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from avatar_models.generator.curves import smooth_cap
 from avatar_models.generator.feet import FootGeometry, FootTrack, pelvis_height_limit, planted
 from avatar_models.generator.plan import LimbTarget, Scene
+
+# Half-width of the window over which the pelvis lowers ahead of a foot it must reach: wide
+# enough that the lowering takes a few tenths of a second (well under 1 g), like a person
+# who bends the knees before stepping down or out.
+CAP_HALF_WIDTH_S = 0.25
 
 
 def home_ankles(scene: Scene, width: float = 1.0) -> dict[str, np.ndarray]:
@@ -45,8 +51,9 @@ def reachable_root(
     scene: Scene, root: np.ndarray, trunk: np.ndarray, feet: dict[str, FootTrack]
 ) -> np.ndarray:
     """``root (T, 3)`` lowered where needed so both legs reach their feet (``trunk (T, 3, 3)``
-    is the root times pelvis rotation)."""
+    is the root times pelvis rotation), smoothly (:func:`~.curves.smooth_cap`)."""
     ankles = np.stack([feet[s].ankle for s in "LR"], axis=1)
     out = root.copy()
-    out[:, 2] = np.minimum(root[:, 2], pelvis_height_limit(scene, root[:, :2], trunk, ankles))
+    limit = pelvis_height_limit(scene, root[:, :2], trunk, ankles)
+    out[:, 2] = smooth_cap(root[:, 2], limit, scene.fps, CAP_HALF_WIDTH_S)
     return out
