@@ -161,15 +161,17 @@ def lunge(scene: Scene) -> Plan:
     )
 
 
-# Front kick: kicking ankle relative to its home (statures) and foot pitch (deg, toes down +)
-# at key fractions of the kick cycle: lift, chamber, snap out, re-chamber, put down, stand.
+# Front kick: kicking ankle relative to its home (statures) and foot pitch in the world (deg,
+# toes down +) at key fractions of the kick cycle: lift, chamber, snap out, re-chamber, put
+# down, stand. At the snap the shank points forward about 50-65 deg from vertical, so a world
+# pitch of -10 deg is an ankle plantarflexed by 40-55 deg (AAOS range 50): the instep leads.
 KICK_KEYS = np.array([0.0, 0.08, 0.25, 0.38, 0.5, 0.65, 0.72, 1.0])
 KICK_POSES = np.array(
     [
         [0.0, 0.0, 0.0, 0.0],
         [0.0, 0.0, 0.04, 0.0],
         [0.12, 0.0, 0.26, 20.0],
-        [0.40, 0.0, 0.42, 35.0],
+        [0.40, 0.0, 0.42, -10.0],
         [0.12, 0.0, 0.26, 20.0],
         [0.0, 0.0, 0.04, 0.0],
         [0.0, 0.0, 0.0, 0.0],

@@ -26,6 +26,15 @@ def scale_rotation(rot: np.ndarray, factor: float) -> np.ndarray:
     return Rotation.from_rotvec(Rotation.from_matrix(rot).as_rotvec() * factor).as_matrix()
 
 
+def twist_about(rot: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """``(T, 3, 3)`` twist part of ``rot (T, 3, 3)`` about ``axis (3,)`` (swing-twist
+    decomposition ``rot = swing @ twist``, the swing moving ``axis`` along the shortest arc)."""
+    axis = _unit(np.asarray(axis, dtype=float))
+    xyzw = Rotation.from_matrix(rot).as_quat()
+    angle = 2.0 * np.arctan2(xyzw[:, :3] @ axis, xyzw[:, 3])
+    return axis_rotation(axis, angle)
+
+
 def _unit(v: np.ndarray) -> np.ndarray:
     return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), 1e-12)
 

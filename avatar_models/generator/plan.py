@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from avatar_models import quat
-from avatar_models.generator.ik import axis_rotation, scale_rotation, two_bone_ik
+from avatar_models.generator.ik import axis_rotation, scale_rotation, twist_about, two_bone_ik
 from avatar_models.generator.subject import Style, Subject
 from avatar_models.motion import Motion
 from avatar_models.skeleton import Skeleton
@@ -179,8 +179,14 @@ def realise(scene: Scene, plan: Plan) -> Motion:
             target.position,
             target.pole,
         )
-        local[:, u], local[:, m] = upper_local, middle_local
         if target.rotation is not None:
-            middle_world = upper_world @ middle_local
-            local[:, e] = np.swapaxes(middle_world, -1, -2) @ target.rotation
+            end_local = np.swapaxes(upper_world @ middle_local, -1, -2) @ target.rotation
+            if hinge is not KNEE_HINGE:
+                # A wrist cannot twist; the forearm turns the hand (pronation/supination), so
+                # the end rotation's twist about the forearm moves into the middle joint.
+                twist = twist_about(end_local, sk.offsets[e])
+                middle_local = middle_local @ twist
+                end_local = np.swapaxes(twist, -1, -2) @ end_local
+            local[:, e] = end_local
+        local[:, u], local[:, m] = upper_local, middle_local
     return _motion(scene, plan, local)
