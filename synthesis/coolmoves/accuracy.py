@@ -7,7 +7,11 @@ the built-in generator.
 - Hand correlation: Pearson coefficient between the input and the output hands, "X, Y and Z
   positions of the hands as independent time series ... for the entire session", averaged
   over the three axes. We correlate head-relative positions (controller minus headset, the
-  signal CoolMoves is given) so that walking forward cannot inflate the number.
+  signal CoolMoves is given) so that walking forward cannot inflate the number. An axis along
+  which the input hand does not move (standard deviation under ``STILL_AXIS_M``, e.g. the
+  lateral axis of a generated ladder climb) has no defined coefficient and is left out of
+  the mean; otherwise millimetre wobble of the output against a constant input reads as
+  "no correlation".
 - Both skip the first ``window - 1`` frames (89 ms), before the first full window exists,
   when any window-based method can only show a default pose.
 - Cross-subject (§4.1.1): per activity, the database holds every other subject's take and the
@@ -36,6 +40,8 @@ PAPER_ACTIVITIES = ("box", "dribble", "climb_ladder", "run", "swim")
 running, swimming)."""
 
 WARM_UP = WINDOW_SAMPLES - 1
+STILL_AXIS_M = 1e-3
+"""An input hand axis with less spread than this (1 mm) does not move (our choice)."""
 _GROUPS = {
     "hands": body17.HANDS,
     "upper": body17.UPPER,
@@ -69,7 +75,9 @@ def hand_correlation(
     head, sides = driver_positions(output[:n], drivers)
     produced = sides - head[:, None]
     r = pearson(given[ok], produced[ok], axis=0)  # (2, 3)
-    return {"left": float(r[0].mean()), "right": float(r[1].mean())}
+    moving = np.std(given[ok], axis=0) >= STILL_AXIS_M
+    mean = np.sum(r * moving, axis=1) / np.maximum(moving.sum(axis=1), 1)
+    return {"left": float(mean[0]), "right": float(mean[1])}
 
 
 def evaluate(

@@ -36,11 +36,13 @@ from synthesis.coolmoves.blend import (
     joint_groups,
 )
 from synthesis.coolmoves.database import Database
-from synthesis.coolmoves.features import search_vectors, sliding_windows
+from synthesis.coolmoves.features import RATE_HZ, search_vectors, sliding_windows
+from synthesis.coolmoves.foot_contact import FootContact
 from synthesis.coolmoves.knn import K_NEIGHBOURS, MAX_DISTANCE, KNNMatcher
 from synthesis.coolmoves.limits import JointLimits
-from synthesis.coolmoves.rotations import to_matrix
 from synthesis.coolmoves.smoothing import ewma, ewma_step
+from synthesis.coolmoves.two_bone import chain_fk
+from synthesis.coolmoves.two_bone import solve as two_bone
 
 _Z = np.array([0.0, 0.0, 1.0])
 
@@ -53,6 +55,11 @@ class Options:
         k: matches per hand. max_distance: KD-tree neighbourhood threshold.
         align: rotation alignment (§3.1.4). smooth: EWMA smoothing. clamp: joint limits.
         matcher: ``"knn"`` (the paper's method) or ``"gmm"`` (the slower mixture variant).
+        arm_ik: beyond the paper, the share (0..1) by which each arm is bent with two-bone IK
+            (:mod:`.two_bone`) so that its controller point reaches the tracked controller;
+            applied where that hand is tracked, after the joint limits, which are applied
+            again. 0 is the paper's output (hands from the blended database poses only).
+        foot_contact: beyond the paper, pin stance feet to the floor (:mod:`.foot_contact`).
     """
 
     k: int = K_NEIGHBOURS
@@ -61,6 +68,57 @@ class Options:
     smooth: bool = True
     clamp: bool = True
     matcher: str = "knn"
+    arm_ik: float = 1.0
+    foot_contact: bool = False
+
+
+_LIMBS = {
+    side + root: tuple(side + part for part in parts)
+    for side in ("l_", "r_")
+    for root, parts in (
+        ("shoulder", ("shoulder", "elbow", "wrist")),
+        ("hip", ("hip", "knee", "ankle")),
+    )
+}
+"""body17 upper, middle and end joints of each limb a driver can govern."""
+
+
+class _Limb:
+    """A two-bone limb (upper, middle, end joint) and the device point on its end joint."""
+
+    def __init__(self, skeleton: Skeleton, joints: tuple[int, int, int], device_offset):
+        self.offsets = skeleton.offsets
+        self.joints = joints
+        self.chain = skeleton.chain(joints[-1])
+        self.device_offset = np.asarray(device_offset, float)
+
+    @classmethod
+    def for_driver(cls, skeleton: Skeleton, limb: str, device: str) -> _Limb | None:
+        """The limb ``limb`` (a body17 name) driven by ``device``, if the device sits on its
+        end joint (else None: no IK for that driver)."""
+        rig = identify_rig(skeleton)
+        attachment = nominal_attachment(device, skeleton)
+        names = _LIMBS.get(limb)
+        if names is None or attachment.joint != names[-1]:
+            return None
+        joints = tuple(skeleton.index(rig.body17[n]) for n in names)
+        return cls(skeleton, joints, attachment.position)
+
+    def reach(
+        self,
+        rotations: np.ndarray,
+        root: np.ndarray,
+        scale: np.ndarray,
+        device: np.ndarray,
+        weight: np.ndarray,
+    ) -> np.ndarray:
+        """``rotations (B, J, 4)`` with the device point moved ``weight (B,)`` of the way to
+        ``device (B, 3)`` (world), by moving the end joint as much (its rotation is kept)."""
+        globs, positions = chain_fk(rotations, root, self.offsets, scale, self.chain)
+        end_pos, end_rot = positions[:, -1], globs[:, -1]
+        point = end_pos + end_rot @ self.device_offset
+        target = end_pos + weight[:, None] * (device - point)
+        return two_bone(rotations, globs[:, -4:], positions[:, -4:], self.joints, target)
 
 
 class CoolMoves(Synthesizer):
@@ -95,6 +153,16 @@ class CoolMoves(Synthesizer):
         head_rest = rest[self._head_chain[-1]] + self._eye
         self._ref_height = standing_height(ref)
         self._ref_hmd_height = float(head_rest[2] - rest[:, 2].min())
+        drv = database.drivers
+        self._arms = [
+            _Limb.for_driver(ref, limb, device)
+            for limb, device in ((drv.left_limb, drv.left), (drv.right_limb, drv.right))
+        ]
+        legs = [[ref.index(rig.body17[f"{s}_{p}"]) for p in ("hip", "knee", "ankle")] for s in "lr"]
+        self._legs = [_Limb(ref, tuple(joints), np.zeros(3)) for joints in legs]
+        ankle = ref.index(rig.body17["l_ankle"])
+        self._ankle_standing = float(rest[ankle, 2] - rest[:, 2].min())
+        self._leg_length = float(np.linalg.norm(ref.offsets[list(legs[0][1:])], axis=-1).sum())
         self.reset()
 
     def _make_matchers(self) -> list:
@@ -119,6 +187,7 @@ class CoolMoves(Synthesizer):
         self._last_time: float | None = None
         self._last_pose: Pose | None = None
         self._device_index: tuple[tuple[str, ...], np.ndarray] | None = None
+        self._feet = FootContact(RATE_HZ)
 
     @property
     def skeleton(self) -> Skeleton:
@@ -185,19 +254,55 @@ class CoolMoves(Synthesizer):
 
         Forward kinematics along the root-to-head chain only, on the rig scaled by ``scale``.
         """
-        ref = self.database.skeleton
-        mats = to_matrix(rotations[:, self._head_chain])  # (B, L, 3, 3)
-        glob = mats[:, 0]
-        pos = np.zeros((rotations.shape[0], 3))
-        for link, j in enumerate(self._head_chain[1:], start=1):
-            pos = pos + glob @ ref.offsets[j]
-            glob = glob @ mats[:, link]
-        head = scale[:, None] * pos + glob @ self._eye
-        return hmd - head
+        origin = np.zeros((rotations.shape[0], 3))
+        globs, positions = chain_fk(
+            rotations, origin, self.database.skeleton.offsets, scale, self._head_chain
+        )
+        return hmd - (positions[:, -1] + globs[:, -1] @ self._eye)
 
-    def _finish(self, smoothed: np.ndarray, hmd: np.ndarray, scale: np.ndarray) -> tuple:
-        rotations = self._limits.clamp(smoothed) if self.options.clamp else smoothed
-        return rotations, self._place(rotations, hmd, scale)
+    def _finish(
+        self,
+        smoothed: np.ndarray,
+        hmd: np.ndarray,
+        scale: np.ndarray,
+        hands: np.ndarray,
+        hands_ok: np.ndarray,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Final rotations ``(B, J, 4)`` and roots ``(B, 3)``: limits, placement, arm IK.
+
+        ``hands (B, 2, 3)`` are the tracked world driver positions, ``hands_ok (B, 2)``.
+        """
+        clamp = self._limits.clamp if self.options.clamp else (lambda r: r)
+        rotations = clamp(smoothed)
+        root = self._place(rotations, hmd, scale)
+        if self.options.arm_ik > 0 and hands_ok.any():
+            for side, arm in enumerate(self._arms):
+                if arm is None:
+                    continue
+                weight = np.where(hands_ok[:, side], self.options.arm_ik, 0.0)
+                rotations = arm.reach(rotations, root, scale, hands[:, side], weight)
+            # The head chain does not pass through an arm: the placement stays exact.
+            rotations = clamp(rotations)
+        if self.options.foot_contact:
+            rotations = self._plant_feet(rotations, root, scale)
+        return rotations, root
+
+    def _plant_feet(self, rotations: np.ndarray, root: np.ndarray, scale: np.ndarray):
+        """``rotations (B, J, 4)`` with stance feet pinned (:mod:`.foot_contact`), frame by
+        frame through the contact state machine, then two-bone IK on all frames at once."""
+        legs = [chain_fk(rotations, root, leg.offsets, scale, leg.chain)[1] for leg in self._legs]
+        ankles = np.stack([p[:, -1] for p in legs], axis=1)  # (B, 2, 3)
+        hips = np.stack([p[:, -3] for p in legs], axis=1)
+        standing, leg_m = scale * self._ankle_standing, scale * self._leg_length
+        targets, fade = np.empty_like(ankles), np.empty(ankles.shape[:2])
+        for b in range(ankles.shape[0]):
+            targets[b], fade[b] = self._feet.update(ankles[b], hips[b], leg_m[b], standing[b])
+        for side, leg in enumerate(self._legs):
+            pinned = fade[:, side] > 0
+            if pinned.any():
+                moved = leg.reach(rotations, root, scale, targets[:, side], np.ones_like(standing))
+                rotations = np.where(pinned[:, None, None], moved, rotations)
+        return rotations
 
     def _default_hmd(self) -> np.ndarray:
         return np.array([0.0, 0.0, self._ref_hmd_height])
@@ -229,7 +334,14 @@ class CoolMoves(Synthesizer):
             self._state = ewma_step(self._state, blended, weight)
             self._initialised |= weight > 0
         hmd = self._default_hmd() if self._hmd is None else self._hmd
-        rotations, root = self._finish(self._state[None], hmd[None], np.array([self._scale or 1.0]))
+        hands = np.where(sides_ok[:, None], frame.positions[[left, right]], 0.0)
+        rotations, root = self._finish(
+            self._state[None],
+            hmd[None],
+            np.array([self._scale or 1.0]),
+            hands[None],
+            sides_ok[None],
+        )
         self._last_pose = Pose(root[0], rotations[0])
         return self._last_pose
 
@@ -264,7 +376,8 @@ class CoolMoves(Synthesizer):
         weight = np.where(seen_before, weight, weight > 0)
         smoothed = ewma(blended, weight, self.database.mean_pose)
         hmd, scale = self._hmd_track(clocked.positions[:, head], ok[:, head])
-        rotations, root = self._finish(smoothed, hmd, scale)
+        hands = np.where(sides_ok[..., None], clocked.positions[:, [left, right]], 0.0)
+        rotations, root = self._finish(smoothed, hmd, scale, hands, sides_ok)
         self._state = smoothed[-1]
         return Motion(
             self.skeleton,

@@ -1,0 +1,114 @@
+"""Analytic two-bone inverse kinematics (shoulder-elbow-wrist, hip-knee-ankle) on local rotations.
+
+Beyond the paper: CoolMoves outputs blended database poses; this module moves a limb's end
+joint to a target with the closed-form two-bone solution (law of cosines), as used for arm
+and leg IK in games (e.g. Unity's TwoBoneIKConstraint):
+
+- the middle joint (elbow, knee) bends about the normal of its current bend plane, i.e. its
+  hinge, until root and end are as far apart as root and target (clipped to the reachable
+  range ``[|l1 - l2|, l1 + l2]``): a hinge joint stays a hinge, inside its limits;
+- the whole limb then swings at the root by the smallest rotation taking the end onto the
+  target, so the bend plane (the elbow or knee pole) is the input pose's, turned as little as
+  possible: the blended database pose decides where the elbow points;
+- the end joint keeps its global orientation (hand or foot do not tilt).
+
+Vectorised over ``B`` poses. Forward kinematics along one chain (:func:`chain_fk`) with numpy
+matrices: the hot path of ``step()`` cannot afford scipy objects (see :mod:`.rotations`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from avatar_models import quat
+from synthesis.coolmoves.rotations import to_matrix
+
+_EPS = 1e-12
+_X, _Z = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
+
+
+def chain_fk(
+    rotations: np.ndarray, root: np.ndarray, offsets: np.ndarray, scale: np.ndarray, chain
+) -> tuple[np.ndarray, np.ndarray]:
+    """Global rotation matrices ``(B, L, 3, 3)`` and positions ``(B, L, 3)`` along ``chain``.
+
+    Args:
+        rotations: ``(B, J, 4)`` local rotations. root: ``(B, 3)`` position of ``chain[0]``.
+        offsets: ``(J, 3)`` rest offsets of the unscaled rig; scale: ``(B,)`` bone scale.
+        chain: ``L`` joint indices from the root, each the parent of the next.
+    """
+    mats = to_matrix(rotations[:, chain])
+    glob, pos = mats[:, 0], np.asarray(root, float)
+    globs, positions = [glob], [pos]
+    for link, j in enumerate(chain[1:], start=1):
+        pos = pos + scale[:, None] * (glob @ offsets[j])
+        glob = glob @ mats[:, link]
+        globs.append(glob)
+        positions.append(pos)
+    return np.stack(globs, axis=1), np.stack(positions, axis=1)
+
+
+def _unit(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    norm = np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / np.maximum(norm, _EPS), norm[..., 0]
+
+
+def _arc(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``(B, 4)`` smallest rotations turning directions ``a`` onto ``b`` ``(B, 3)``."""
+    a, _ = _unit(a)
+    b, _ = _unit(b)
+    q = np.concatenate([1.0 + np.sum(a * b, axis=-1, keepdims=True), np.cross(a, b)], axis=-1)
+    # Antiparallel directions never occur between a bone and its corrected self; guard anyway.
+    return np.where(q[:, :1] > _EPS, q, quat.IDENTITY) / np.maximum(
+        np.linalg.norm(q, axis=-1, keepdims=True), _EPS
+    )
+
+
+def _in_frame(q: np.ndarray, frame: np.ndarray) -> np.ndarray:
+    """World rotation ``q (B, 4)`` expressed in the local axes ``frame (B, 3, 3)``:
+    ``frame^T R frame`` is the same angle about the axis ``frame^T n``."""
+    vec = np.einsum("bji,bj->bi", frame, q[:, 1:])
+    return np.concatenate([q[:, :1], vec], axis=-1)
+
+
+def solve(
+    rotations: np.ndarray,
+    globs: np.ndarray,
+    positions: np.ndarray,
+    joints: tuple[int, int, int],
+    target: np.ndarray,
+) -> np.ndarray:
+    """Local rotations ``(B, J, 4)`` with the end joint of ``joints`` moved to ``target``.
+
+    Args:
+        rotations: ``(B, J, 4)`` local rotations.
+        globs, positions: ``(B, 4, 3, 3)`` and ``(B, 4, 3)`` global rotations and positions of
+            the upper joint's parent, the upper, middle and end joints (from :func:`chain_fk`).
+        joints: indices of the upper, middle and end joints (shoulder, elbow, wrist).
+        target: ``(B, 3)`` where the end joint should go.
+    """
+    parent, upper, middle = globs[:, 0], globs[:, 1], globs[:, 2]
+    a, b, c = positions[:, 1], positions[:, 2], positions[:, 3]
+    u1, l1 = _unit(b - a)
+    u2, l2 = _unit(c - b)
+    d = np.clip(np.linalg.norm(target - a, axis=-1), np.abs(l1 - l2) + 1e-9, l1 + l2 - 1e-9)
+    # 1. Bend the middle joint about the normal of its current bend plane (its hinge) until
+    #    root and end are ``d`` apart (law of cosines on the bend angle u1 -> u2).
+    normal, bent = _unit(np.cross(u1, u2))
+    straight = bent < 1e-9  # a fully straight limb has no plane: bend about a horizontal axis
+    fallback, _ = _unit(np.cross(u1, np.where(np.abs(u1[:, 2:]) < 0.9, _Z, _X)))
+    normal = np.where(straight[:, None], fallback, normal)
+    bend_now = np.arctan2(bent, np.sum(u1 * u2, axis=-1))
+    cos_bend = np.clip((d**2 - l1**2 - l2**2) / (2.0 * l1 * l2), -1.0, 1.0)
+    turn_lower = quat.from_axis_angle(normal, np.arccos(cos_bend) - bend_now)
+    new_c = b + quat.rotate(turn_lower, c - b)
+    # 2. Swing the whole limb at the root, by the smallest rotation, onto the target.
+    turn_upper = _arc(new_c - a, target - a)
+    i, j, k = joints
+    out = rotations.copy()
+    out[:, i] = quat.mul(_in_frame(turn_upper, parent), rotations[:, i])
+    out[:, j] = quat.mul(_in_frame(turn_lower, upper), rotations[:, j])
+    # The end joint keeps its global rotation: undo both turns in the old middle frame.
+    both = quat.mul(turn_upper, turn_lower)
+    out[:, k] = quat.mul(quat.conj(_in_frame(both, middle)), rotations[:, k])
+    return out
