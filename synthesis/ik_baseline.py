@@ -40,8 +40,9 @@ STEERED_SITES = ("head", "l_wrist", "r_wrist", "pelvis", "l_ankle", "r_ankle")
 """The humanoid's body17 sites the IK steers, in target order."""
 DEVICE_SITES = {"hmd": "head", "left_controller": "l_wrist", "right_controller": "r_wrist"}
 
-POSITION_COST = np.array([1.0, 1.0, 1.0, 0.05, 0.05, 0.05])
-"""Tracked joints dominate; the pelvis hint and the stepper's feet are soft (VRIK's body and
+POSITION_COST = np.array([10.0, 1.0, 1.0, 0.05, 0.05, 0.05])
+"""Tracked joints dominate, the head most (VRIK locks the head: an out-of-reach hand must not
+drag the body along); the pelvis hint and the stepper's feet are soft (VRIK's body and
 leg weights are likewise below the head and hand weights)."""
 ORIENTATION_COST = np.array([0.1, 0.01, 0.01, 0.0, 0.0, 0.0])
 """Head and hand orientation follow their devices far more loosely than their positions

@@ -1,0 +1,110 @@
+"""IK baseline: head and hands reach targets taken from a known pose; unreachable targets
+give the closest reach; missing devices never produce NaN."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from avatar_models import body17
+from avatar_models.generator import Subject, generate
+from avatar_models.measure import standing_height
+from avatar_models.rigs import body17_positions
+from render_cams import VRSetup
+from synthesis.base import SynthesisError, TrackingFrame
+from synthesis.ik_baseline import IKBaseline, Stepper
+
+TRACKED = body17.group_indices(("head", "l_wrist", "r_wrist"))
+
+
+@pytest.fixture(scope="module")
+def dribble():
+    """A known pose sequence (FK of generated motion) and its simulated devices."""
+    motion = generate("dribble", Subject(height_m=1.75), 1.5, 90.0, seed=3)
+    return motion, VRSetup().sample(motion, seed=0)
+
+
+@pytest.fixture(scope="module")
+def dribble_output(dribble):
+    motion, stream = dribble
+    return IKBaseline(motion.skeleton, standing_height(motion)).run(stream)
+
+
+def test_head_and_hands_reach_reachable_targets(dribble, dribble_output):
+    motion, _ = dribble
+    err = np.linalg.norm(
+        body17_positions(dribble_output)[:, TRACKED] - body17_positions(motion)[:, TRACKED],
+        axis=-1,
+    )
+    assert dribble_output.n_frames == motion.n_frames
+    assert np.median(err) < 0.01
+    assert np.percentile(err, 95) < 0.02
+
+
+def test_joint_targets_undo_the_device_attachments(dribble):
+    motion, stream = dribble
+    ik = IKBaseline(motion.skeleton)
+    targets = ik.joint_targets(stream.positions[10], stream.quaternions[10])
+    assert np.allclose(targets[:, :3], body17_positions(motion)[10, TRACKED], atol=1e-9)
+
+
+def test_unreachable_hand_reaches_straight_at_it(dribble):
+    motion, stream = dribble
+    ik = IKBaseline(motion.skeleton, standing_height(motion))
+    far = stream.positions.copy()
+    far[:, 2] = far[:, 0] + np.array([3.0, -0.2, -0.3])  # right controller 3 m ahead
+    out = ik.run(stream.replace(positions=far))
+    pos = body17_positions(out)
+    assert np.isfinite(out.local_rot).all() and np.isfinite(out.root_pos).all()
+    target = far[-1, 2]
+    shoulder, wrist = pos[-1, body17.INDEX["r_shoulder"]], pos[-1, body17.INDEX["r_wrist"]]
+    rest = motion.skeleton.rest_positions()
+    reach = sum(
+        np.linalg.norm(rest[motion.skeleton.index(a)] - rest[motion.skeleton.index(b)])
+        for a, b in (("Bip01 R Forearm", "Bip01 R UpperArm"), ("Bip01 R Hand", "Bip01 R Forearm"))
+    )
+    # The closest reach: the arm is stretched out at the target, so the hand is nearer to
+    # it than the shoulder by almost the whole arm length.
+    gain = np.linalg.norm(target - shoulder) - np.linalg.norm(target - wrist)
+    assert gain > 0.75 * reach
+
+
+def test_dropouts_and_nan_hold_finite(dribble):
+    motion, stream = dribble
+    positions, valid = stream.positions.copy(), stream.valid.copy()
+    positions[20:60, 1] = np.nan
+    valid[40:80, 2] = False
+    out = IKBaseline(motion.skeleton).run(stream.replace(positions=positions, valid=valid))
+    assert out.n_frames == motion.n_frames
+    assert np.isfinite(out.local_rot).all() and np.isfinite(out.root_pos).all()
+
+
+def test_step_matches_run(dribble, dribble_output):
+    motion, stream = dribble
+    ik = IKBaseline(motion.skeleton, standing_height(motion))
+    ik.reset()
+    poses = [ik.step(TrackingFrame.from_stream(stream, i)) for i in range(5)]
+    assert np.allclose(np.stack([p.root_pos for p in poses]), dribble_output.root_pos[:5])
+
+
+def test_missing_devices_are_a_clear_error(dribble):
+    motion, stream = dribble
+    with pytest.raises(SynthesisError, match="needs devices"):
+        IKBaseline(motion.skeleton).run(
+            stream.replace(
+                device_names=("hmd",),
+                positions=stream.positions[:, :1],
+                quaternions=stream.quaternions[:, :1],
+                valid=stream.valid[:, :1],
+            )
+        )
+
+
+def test_stepper_steps_once_the_stance_moves_away():
+    feet = np.array([[0.0, 0.1, 0.1], [0.0, -0.1, 0.1]])
+    stepper = Stepper(feet.copy())
+    assert np.allclose(stepper.advance(feet, np.zeros(3), 1 / 90), feet)  # standing still
+    moved = feet + np.array([0.3, 0.0, 0.0])
+    for _ in range(60):  # 0.67 s: time for both feet to step
+        out = stepper.advance(moved, np.zeros(3), 1 / 90)
+    assert np.allclose(out, moved)
