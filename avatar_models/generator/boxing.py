@@ -124,6 +124,7 @@ def box(scene: Scene) -> Plan:
 
     def hand_target(rel: np.ndarray) -> np.ndarray:
         return root_pos + (rel * scale - rest_root) @ lean.T
+
     plan = Plan(
         root_pos=root_pos,
         root_rot=root_rot,

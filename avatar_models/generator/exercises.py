@@ -124,7 +124,9 @@ def lunge(scene: Scene) -> Plan:
         a_back, r_back, toe_back = swing_between(
             geom, back_tau, front + geom.ball, home + geom.heel, 0.05 * height
         )
-        rear_pitch = np.radians(40.0) * sink
+        # Heel up to 55 deg in the deep lunge: the rear ankle then stays within its
+        # weight-bearing dorsiflexion (40 deg); the toes take the extension (range 70).
+        rear_pitch = np.radians(55.0) * sink
         a_rear, r_rear, toe_rear = foot_pose(geom, home + geom.ball, rear_pitch, np.ones(n, bool))
         going_back = ph >= 0.8
         lead_ankle = np.where(going_back[:, None], a_back, a_out)

@@ -13,9 +13,8 @@ import numpy as np
 
 from avatar_models.generator.curves import bump, phase, swing_progress, window
 from avatar_models.generator.feet import SWING_LIFT, FootGeometry, FootTrack
-from avatar_models.generator.ik import axis_rotation
 from avatar_models.generator.plan import LimbTarget, Plan, Scene
-from avatar_models.generator.poses import Z_AXIS, gaze, heading_rotation, trunk
+from avatar_models.generator.poses import gaze, heading_rotation, trunk
 from avatar_models.generator.standing import leg_targets, reachable_root
 
 RUNG_SPACING_M = 0.305
@@ -83,10 +82,11 @@ def climb_ladder(scene: Scene) -> Plan:
             0.12 * scale,
             0.06,
         )
-        # Fingers forward over the rung, palm down.
-        grip = axis_rotation(Z_AXIS, np.full(n, sign * np.pi / 2))
+        # The hand continues the forearm (neutral wrist) and hooks the rung with the fingers:
+        # a world "fingers forward, palm down" target bends the wrist past its ranges when
+        # the forearm points up along the ladder.
         pole = np.broadcast_to([-0.3, -sign * 1.0, -1.0], (n, 3))
-        arms[hand_side] = LimbTarget(hand, pole, grip)
+        arms[hand_side] = LimbTarget(hand, pole)
     legs, toes = leg_targets(scene, feet, (1.0, 0.25, 0.0))
     lowest = np.minimum(feet["L"].ankle[:, 2], feet["R"].ankle[:, 2]) - ankle_h
     root = np.column_stack(

@@ -103,9 +103,7 @@ def _gait_plan(scene: Scene, gait: Gait) -> tuple[Plan, np.ndarray]:
     nominal = rest_z - (gait.crouch + style.knee_bend) * scene.leg_length + bob
     ankles = np.stack([tr.ankle for tr in tracks], axis=1)
     limit = pelvis_height_limit(scene, root_xy, root_rot @ pelvis, ankles)
-    root_pos = np.column_stack(
-        [root_xy, smooth_cap(nominal, limit, scene.fps, CAP_HALF_WIDTH_S)]
-    )
+    root_pos = np.column_stack([root_xy, smooth_cap(nominal, limit, scene.fps, CAP_HALF_WIDTH_S)])
 
     joints = {}
     for side, tr in zip("LR", tracks, strict=True):
