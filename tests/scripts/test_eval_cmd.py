@@ -1,0 +1,61 @@
+"""``avatarsim eval``: contract JSON and plots; exit 2 with a reason for bad input."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from typer.testing import CliRunner
+
+from scripts.cli import app
+
+runner = CliRunner()
+SMALL = ["--subjects", "2", "--takes", "1", "--duration", "1.5", "--no-ablation"]
+
+
+def test_eval_builtin_writes_contract_json_and_plots(tmp_path):
+    out, js = tmp_path / "out", tmp_path / "r.json"
+    result = runner.invoke(
+        app,
+        ["eval", "coolmoves", "--library", "builtin", "--classes", "box", *SMALL,
+         "--out", str(out), "--json", str(js)],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    payload = json.loads(js.read_text())
+    for summary in (payload["overall"], payload["per_activity"]["box"]):
+        assert {"err_cm", "baseline_err_cm", "hand_corr", "frames_per_s"} <= set(summary)
+        assert set(summary["err_cm"]) == {"hands", "upper", "lower", "full"}
+    assert {p.name for p in out.iterdir()} >= {
+        "eval.json",
+        "errors_by_group.png",
+        "errors_by_activity.png",
+    }
+
+
+@pytest.mark.parametrize(
+    ("args", "reason"),
+    [
+        (["eval", "magic"], "unknown method"),
+        (["eval", "coolmoves", "--protocol", "cross-galaxy"], "unknown protocol"),
+        (["eval", "coolmoves", "--library", "/no/such/folder"], "not"),
+    ],
+)
+def test_bad_input_exits_2_with_a_reason(args, reason):
+    result = runner.invoke(app, args)
+    assert result.exit_code == 2
+    assert reason in result.output
+
+
+def test_folder_without_clips_exits_2(tmp_path):
+    result = runner.invoke(app, ["eval", "coolmoves", "--library", str(tmp_path)])
+    assert result.exit_code == 2 and "no motion clips" in result.output
+
+
+@pytest.mark.mocap
+def test_bandai_cross_subject_says_why_it_is_impossible(mocap_dir):
+    folder = mocap_dir / "bandai" / "dataset-2"
+    result = runner.invoke(
+        app, ["eval", "coolmoves", "--library", str(folder), "--classes", "normal",
+              "--max-per-class", "2", "--protocol", "cross-subject"],
+    )  # fmt: skip
+    assert result.exit_code == 2 and "subject labels" in result.output
