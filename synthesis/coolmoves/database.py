@@ -103,6 +103,11 @@ class Database:
     def window_samples(self) -> int:
         return int(self.windows.shape[1])
 
+    def window_clips(self) -> np.ndarray:
+        """``(N,)`` index into :attr:`clips` of the source motion of every window."""
+        kept = [i for i, c in enumerate(self.clips) if c["kept"]]
+        return np.repeat(kept, [self.clips[i]["windows"] for i in kept])
+
 
 def labels(motion: Motion) -> dict[str, Any]:
     """Activity, subject and style of a motion from its ``meta`` (library or generator)."""

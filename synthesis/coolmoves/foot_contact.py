@@ -34,13 +34,14 @@ RELEASE_HEIGHT_M = 0.1
 """Hysteresis: a pinned foot stays pinned until its free (synthesised) ankle rises this far
 above standing height; synthesised feet pass the floor without stopping, so the contact
 test alone would pin for a frame or two at a time."""
-STEP_HEIGHT_M = 0.12
+STEP_HEIGHT_M = 0.09
 """Apex of the arc a released foot takes back to the free pose (our choice; walking foot
-clearance is 10-15 cm at mid-swing for the ankle)."""
+clearance; chosen on the generated cross-subject run so that the arc clears the 5 cm
+contact height for most of its frames without lifting the foot far from the truth)."""
 MAX_REACH = 0.999
 """A stance ends once its anchor is farther from the hip than this share of the leg's length:
 a body carried on by the headset would otherwise drag a straight leg behind it."""
-MAX_SLIP_M = 0.2
+MAX_SLIP_M = 0.1
 """A stance ends once the free (synthesised) ankle is this far from the anchor horizontally:
 the database pose has taken a step the pin would otherwise cancel."""
 

@@ -45,6 +45,10 @@ from synthesis.coolmoves.two_bone import chain_fk
 from synthesis.coolmoves.two_bone import solve as two_bone
 
 _Z = np.array([0.0, 0.0, 1.0])
+EYE_HEIGHT_FRAC = 0.936
+ANKLE_HEIGHT_FRAC = 0.039
+"""Eye and ankle heights over stature (Drillis & Contini 1966, the segment-length
+proportions in Winter, *Biomechanics and Motor Control of Human Movement*, Fig. 4.1)."""
 
 
 @dataclass(frozen=True)
@@ -153,6 +157,10 @@ class CoolMoves(Synthesizer):
         head_rest = rest[self._head_chain[-1]] + self._eye
         self._ref_height = standing_height(ref)
         self._ref_hmd_height = float(head_rest[2] - rest[:, 2].min())
+        upright = self._ref_hmd_height >= 0.8 * self._ref_height
+        if not upright:
+            # A rest pose that is not upright (Bandai's): eye height from stature instead.
+            self._ref_hmd_height = EYE_HEIGHT_FRAC * self._ref_height
         drv = database.drivers
         self._arms = [
             _Limb.for_driver(ref, limb, device)
@@ -161,7 +169,11 @@ class CoolMoves(Synthesizer):
         legs = [[ref.index(rig.body17[f"{s}_{p}"]) for p in ("hip", "knee", "ankle")] for s in "lr"]
         self._legs = [_Limb(ref, tuple(joints), np.zeros(3)) for joints in legs]
         ankle = ref.index(rig.body17["l_ankle"])
-        self._ankle_standing = float(rest[ankle, 2] - rest[:, 2].min())
+        self._ankle_standing = (
+            float(rest[ankle, 2] - rest[:, 2].min())
+            if upright
+            else ANKLE_HEIGHT_FRAC * self._ref_height
+        )
         self._leg_length = float(np.linalg.norm(ref.offsets[list(legs[0][1:])], axis=-1).sum())
         self.reset()
 
