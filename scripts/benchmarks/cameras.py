@@ -22,8 +22,8 @@ from scripts.benchmarks import BenchRow, best_of
 SENSOR_FPS = 30.0
 
 
-def _render_rate(motion, poses, model, face_size, frames: int) -> float:
-    with BodyScene(motion.skeleton) as scene:
+def _render_rate(motion, poses, model, face_size, shading: str, frames: int) -> float:
+    with BodyScene(motion.skeleton, shading=shading) as scene:
         renderer = FisheyeRenderer(scene, model, face_size)
 
         def render_all():
@@ -31,7 +31,16 @@ def _render_rate(motion, poses, model, face_size, frames: int) -> float:
                 scene.update(motion, t)
                 renderer.render(poses[t, 0])
 
+        render_all()  # warm-up: GL context, shader compilation
         return frames / best_of(render_all, repeat=2)
+
+
+# (face_size, shading, label): the default path, and the pre-optimisation one (five full
+# 90 deg faces at the fisheye's centre resolution, pyrender's PBR shader) for comparison.
+RENDER_CONFIGS = (
+    (None, "matte", "cropped resolution-matched faces, matte"),
+    (496, "pbr", "five full 496 px faces, PBR (previous default)"),
+)
 
 
 def run(quick: bool = False) -> list[BenchRow]:
@@ -41,8 +50,8 @@ def run(quick: bool = False) -> list[BenchRow]:
     model = FisheyeModel.from_fov()
     frames = 5 if quick else 20
     rows = []
-    for face_size, label in ((None, "default cube faces"), (256, "256 px cube faces")):
-        rate = _render_rate(motion, poses, model, face_size, frames)
+    for face_size, shading, label in RENDER_CONFIGS:
+        rate = _render_rate(motion, poses, model, face_size, shading, frames)
         rows.append(
             BenchRow(
                 f"fisheye render 640x480 ({label})", "frames/s", rate, SENSOR_FPS, "sensor 30 fps"
