@@ -30,6 +30,7 @@ from avatar_models.rigs import body17_positions
 from render_cams import TrackingStream, VRSetup
 from render_cams.device import motion_at_rate
 from synthesis.base import Synthesizer, on_clock, usable_mask
+from synthesis.coolmoves import foot_contact
 from synthesis.coolmoves.correlation import pearson
 from synthesis.coolmoves.database import HANDS_DRIVE, Drivers, build_database, driver_positions
 from synthesis.coolmoves.features import WINDOW_SAMPLES
@@ -40,6 +41,7 @@ PAPER_ACTIVITIES = ("box", "dribble", "climb_ladder", "run", "swim")
 running, swimming)."""
 
 WARM_UP = WINDOW_SAMPLES - 1
+_ANKLES = ("l_ankle", "r_ankle")
 STILL_AXIS_M = 1e-3
 """An input hand axis with less spread than this (1 mm) does not move (our choice)."""
 _GROUPS = {
@@ -78,6 +80,16 @@ def hand_correlation(
     moving = np.std(given[ok], axis=0) >= STILL_AXIS_M
     mean = np.sum(r * moving, axis=1) / np.maximum(moving.sum(axis=1), 1)
     return {"left": float(mean[0]), "right": float(mean[1])}
+
+
+def stance_skating_cm_s(output: Motion, standing_ankle_z: float) -> float:
+    """Mean horizontal ankle speed (cm/s) over the frames where ``output``'s own ankles are in
+    contact (:func:`~.foot_contact.contacts`, the UHC/PhysDiff height and velocity test against
+    the ankles' standing height ``standing_ankle_z``, e.g.
+    :attr:`CoolMoves.standing_ankle_height`)."""
+    ankles = body17_positions(output)[:, body17.group_indices(_ANKLES)]
+    contact = foot_contact.contacts(ankles, standing_ankle_z, output.fps)
+    return foot_contact.skating_cm_s(ankles, contact, output.fps)
 
 
 def evaluate(

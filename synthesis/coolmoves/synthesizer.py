@@ -206,6 +206,11 @@ class CoolMoves(Synthesizer):
         """The output rig: the database rig scaled to the user's height (once known)."""
         return self.database.skeleton.scaled(self._scale or 1.0)
 
+    @property
+    def standing_ankle_height(self) -> float:
+        """Height (m) of the output's ankles above the floor when standing (foot contact)."""
+        return (self._scale or 1.0) * self._ankle_standing
+
     def _scale_for(self, height_m: float | None) -> float | None:
         return None if height_m is None else float(height_m) / self._ref_height
 
