@@ -36,28 +36,39 @@ CONTRACT_KEYS = (
 )
 
 
-def body_and_motion(motion: Motion, body: BodyDescription | None) -> tuple[BodyDescription, Motion]:
+def body_and_motion(
+    motion: Motion, body: BodyDescription | None, retarget_foreign: bool = True
+) -> tuple[BodyDescription, Motion]:
     """The body to replay ``motion`` on and the motion on that body's skeleton.
 
+    A motion on a rig whose rest pose does not stand (e.g. Bandai), or on another rig than
+    ``body``'s, is retargeted onto the humanoid by body17 IK (:func:`sim.retarget.retarget`);
+    its mean residual is recorded in the returned motion's ``meta["retarget_residual_cm"]``.
+
     Raises:
-        RetargetingNeeded: the rig's rest pose does not stand, or ``body`` is another rig.
+        RetargetingNeeded: such a motion with ``retarget_foreign=False``.
         BodyError: the skeleton is no known rig.
     """
+    reason = None
     if body is None:
         try:
             body = build_body(motion.skeleton)
         except BodyError as exc:
-            if "not upright" in str(exc):
-                raise RetargetingNeeded(
-                    f"{exc}; retarget the motion onto a humanoid rig first"
-                ) from exc
-            raise
-    if not motion.skeleton.same_topology(body.skeleton):
-        raise RetargetingNeeded(
-            f"motion rig {motion.skeleton.name!r} is not the body's rig "
-            f"{body.skeleton.name!r}; retarget the motion onto the body first"
-        )
-    return body, motion
+            if "not upright" not in str(exc):
+                raise
+            reason = str(exc)
+    elif not motion.skeleton.same_topology(body.skeleton):
+        reason = f"motion rig {motion.skeleton.name!r} is not the body's rig {body.skeleton.name!r}"
+    if reason is None:
+        return body, motion
+    if not retarget_foreign:
+        raise RetargetingNeeded(f"{reason}; retarget the motion onto a humanoid rig first")
+    from sim.retarget import retarget  # IK (mink) is only loaded when needed
+
+    result = retarget(motion, body)
+    meta = {**result.motion.meta, "retarget_residual_cm": float(np.mean(result.residual_cm))}
+    out = result.motion.replace(meta=meta)
+    return (body if body is not None else build_body(out.skeleton)), out
 
 
 @dataclass(frozen=True, eq=False)

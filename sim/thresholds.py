@@ -9,7 +9,12 @@ skating are measured in the floor frame (floor at z = 0, Z up):
   height is below ``contact_height_m`` AND its vertical speed is below ``contact_vz_m_s``
   (height and velocity, as UHC/PhysDiff label contacts; the vertical speed only, so that a
   foot sliding on the floor still counts as in contact and its sliding is measured). The
-  5 cm height is the usual foot-contact height of those papers.
+  5 cm height is the usual foot-contact height of those papers. A contact must last at least
+  ``contact_min_s`` (70 ms: below the shortest stance of sprinting, longer than a swing
+  toe skimming the floor for a frame or two, which real walks do with 1-2 cm clearance), and
+  a point moving faster than ``contact_vxy_m_s`` horizontally (2.5 m/s) is swinging, not
+  standing: a low swing (gait initiation, shuffling) is kinematically indistinguishable from
+  sliding above that speed, and mocap feet slide far slower than that while planted.
 - **penetration**: depth of the deepest MuJoCo floor contact (cm) per frame; the clip's value
   is its 95th percentile.
 - **floating**: height of the lowest body point above the floor (cm) when nothing supports
@@ -75,6 +80,8 @@ class CheckConfig:
     # -- definitions --------------------------------------------------------------------
     contact_height_m: float = 0.05
     contact_vz_m_s: float = 0.3
+    contact_min_s: float = 0.07
+    contact_vxy_m_s: float = 2.5
     float_window_s: float = 0.5
     skate_speed_cm_s: float = 10.0
     limit_tolerance_deg: float = 20.0

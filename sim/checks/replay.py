@@ -14,6 +14,7 @@ from functools import cached_property
 
 import mujoco
 import numpy as np
+from scipy import ndimage
 
 from avatar_models.body import BodyDescription, Segment
 from sim.replay import ReplayTrace, replay_kinematic
@@ -124,11 +125,22 @@ class BodyReplay:
 
     @cached_property
     def point_contact(self) -> np.ndarray:
-        """``(T, 2, P)`` sole points in contact: low AND not moving vertically."""
+        """``(T, 2, P)`` sole points in contact: low, not moving vertically, slower than a
+        swinging foot horizontally, for at least
+        ``contact_min_s`` in a row (a swinging toe skimming the floor for a frame or two, as
+        it does in normal gait with ~1-2 cm clearance, is no stance)."""
         c = self.config
         low = self.sole_points[..., 2] < c.contact_height_m
         still = np.abs(self.sole_velocity[..., 2]) < c.contact_vz_m_s
-        return low & still
+        slow = np.linalg.norm(self.sole_velocity[..., :2], axis=-1) < c.contact_vxy_m_s
+        points = low & still & slow
+        run = max(1, int(np.ceil(c.contact_min_s * self.fps - 1e-9)))
+        if run == 1:
+            return points
+        # A foot's contact (any of its points) must last ``run`` frames: binary opening along
+        # time removes shorter runs and keeps the rest; its points keep their own labels.
+        foot = ndimage.binary_opening(points.any(axis=2), structure=np.ones((run, 1), dtype=bool))
+        return points & foot[..., None]
 
     @property
     def foot_contact(self) -> np.ndarray:

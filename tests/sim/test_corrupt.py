@@ -11,6 +11,10 @@ from avatar_models.generator import generate
 from sim import corrupt
 from sim.plausibility import check_motion
 
+# The generated run still bends the ankle past its range at toe-off (tests/avatar_models/
+# test_generator_physics.py tracks it); strict, so the fix is noticed.
+GENERATED_RUN_GAP = "generated run exceeds ankle joint limits at toe-off"
+
 DEFECTS = ("penetration", "floating", "joint_limits", "skating", "jitter")
 
 
@@ -33,7 +37,14 @@ def assert_suite(motion):
         assert check_motion(bad, body).flagged(defect), defect
 
 
-@pytest.mark.parametrize("activity", ["walk", "run", "squat"])
+@pytest.mark.parametrize(
+    "activity",
+    [
+        "walk",
+        pytest.param("run", marks=pytest.mark.xfail(strict=True, reason=GENERATED_RUN_GAP)),
+        "squat",
+    ],
+)
 def test_generated_suite_is_flagged(activity):
     assert_suite(generate(activity, duration_s=2.0, seed=1))
 
