@@ -31,8 +31,14 @@ _DEFAULT_ORDER = "XYZ"
 class JointLimits:
     """Clamp local rotations to a skeleton's joint limits, all joints in one vectorised pass."""
 
-    def __init__(self, skeleton: Skeleton, widen_to: np.ndarray | None = None):
-        """``widen_to``: optional ``(P, J, 4)`` poses whose angles every range must include."""
+    def __init__(
+        self,
+        skeleton: Skeleton,
+        widen_to: np.ndarray | None = None,
+        only: set[int] | None = None,
+    ):
+        """``widen_to``: optional ``(P, J, 4)`` poses whose angles every range must include;
+        ``only``: limit just these joint indices (default: every joint with limits)."""
         try:
             rig = identify_rig(skeleton)
             roles = classify(skeleton, rig).roles
@@ -41,6 +47,8 @@ class JointLimits:
         joints, orders, pairs = [], [], []
         for name in skeleton.limits:
             j = skeleton.index(name)
+            if only is not None and j not in only:
+                continue
             role = roles.get(j)
             joints.append(j)
             orders.append(euler_order(role) if role not in (None, "root") else _DEFAULT_ORDER)

@@ -168,6 +168,8 @@ class CoolMoves(Synthesizer):
         ]
         legs = [[ref.index(rig.body17[f"{s}_{p}"]) for p in ("hip", "knee", "ankle")] for s in "lr"]
         self._legs = [_Limb(ref, tuple(joints), np.zeros(3)) for joints in legs]
+        arm_joints = {j for arm in self._arms if arm is not None for j in arm.joints}
+        self._arm_limits = JointLimits(ref, widen_to=database.poses, only=arm_joints)
         ankle = ref.index(rig.body17["l_ankle"])
         self._ankle_standing = (
             float(rest[ankle, 2] - rest[:, 2].min())
@@ -299,7 +301,8 @@ class CoolMoves(Synthesizer):
                 weight = np.where(hands_ok[:, side], self.options.arm_ik, 0.0)
                 rotations = arm.reach(rotations, root, scale, hands[:, side], weight)
             # The head chain does not pass through an arm: the placement stays exact.
-            rotations = clamp(rotations)
+            if self.options.clamp:
+                rotations = self._arm_limits.clamp(rotations)
         if self.options.foot_contact:
             rotations = self._plant_feet(rotations, root, scale)
         return rotations, root
