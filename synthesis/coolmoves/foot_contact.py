@@ -35,9 +35,9 @@ RELEASE_HEIGHT_M = 0.1
 above standing height; synthesised feet pass the floor without stopping, so the contact
 test alone would pin for a frame or two at a time."""
 STEP_HEIGHT_M = 0.09
-"""Apex of the arc a released foot takes back to the free pose (our choice; walking foot
-clearance; chosen on the generated cross-subject run so that the arc clears the 5 cm
-contact height for most of its frames without lifting the foot far from the truth)."""
+"""Apex of the arc a released foot takes back to the free pose (our choice, on the generated
+cross-subject run and dribble: the arc clears the 5 cm contact height for most of its frames
+without lifting the foot far from the truth)."""
 MAX_REACH = 0.999
 """A stance ends once its anchor is farther from the hip than this share of the leg's length:
 a body carried on by the headset would otherwise drag a straight leg behind it."""
