@@ -33,6 +33,8 @@ from typing import Any
 
 from avatar_models.errors import AvatarsimError
 
+VR_NOISE = ("none", "realistic")
+
 
 class ScenarioError(AvatarsimError):
     """A scenario file is missing, malformed or asks for something impossible."""
@@ -64,6 +66,36 @@ class ReportSpec:
 
 
 @dataclass(frozen=True)
+class DevicesSpec:
+    """Simulated VR tracking (``render_cams.vr``); ``noise`` is ``"none"`` or ``"realistic"``
+    (Lighthouse-grade jitter, latency, slow drift)."""
+
+    vr: bool = True
+    trackers: bool = False
+    noise: str = "realistic"
+
+
+@dataclass(frozen=True)
+class SynthesisSpec:
+    """Full-body synthesis from the VR stream. The CoolMoves database holds built-in takes of
+    the scenario's activity by ``database_subjects`` other (seeded) subjects."""
+
+    methods: tuple[str, ...] = ("coolmoves", "ik")
+    database_subjects: int = 4
+    database_duration_s: float = 8.0
+    foot_contact: bool = True  # CoolMoves' stance-foot clean-up (beyond the paper)
+    arm_ik: float = 1.0  # CoolMoves' arm correction toward the controllers (0 = the paper's)
+
+
+@dataclass(frozen=True)
+class CamerasSpec:
+    """Rendered device views for the report: controller fisheye cameras, a Kinect."""
+
+    fisheye: bool = True
+    kinect: str | None = "kinect-v2"
+
+
+@dataclass(frozen=True)
 class Threshold:
     """Pass when ``value <= max`` (and/or ``value >= min``)."""
 
@@ -89,6 +121,9 @@ class Scenario:
     motion: MotionSpec = field(default_factory=MotionSpec)
     body: BodySpec = field(default_factory=BodySpec)
     report: ReportSpec = field(default_factory=ReportSpec)
+    devices: DevicesSpec | None = None
+    synthesis: SynthesisSpec | None = None
+    cameras: CamerasSpec | None = None
     thresholds: dict[str, Threshold] = field(default_factory=dict)
     physics: dict[str, float] = field(default_factory=dict)
     path: str | None = None
@@ -101,6 +136,11 @@ def _check_type(value: Any, annotation: Any, where: str) -> Any:
     )
     if value is None and type(None) in allowed:
         return value
+    if typing.get_origin(annotation) is tuple:
+        item = typing.get_args(annotation)[0]
+        if not isinstance(value, list):
+            raise ScenarioError(f"{where} must be a list, got {value!r}")
+        return tuple(_check_type(v, item, f"{where}[{i}]") for i, v in enumerate(value))
     for typ in allowed:
         if typ is float and isinstance(value, int | float) and not isinstance(value, bool):
             return float(value)
@@ -132,13 +172,28 @@ def _threshold(name: str, raw: Any) -> Threshold:
 
 def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
     """Validate a parsed TOML table into a :class:`Scenario`."""
-    top = {"name", "seed", "motion", "body", "report", "thresholds", "physics"}
+    top = {"name", "seed", "motion", "body", "report", "devices", "synthesis", "cameras"}
+    top |= {"thresholds", "physics"}
     unknown = sorted(set(data) - top)
     if unknown:
         raise ScenarioError(f"unknown top-level key(s) {unknown}; allowed: {sorted(top)}")
     motion = _section(MotionSpec, data.get("motion", {}), "motion")
     body = _section(BodySpec, data.get("body", {}), "body")
     report = _section(ReportSpec, data.get("report", {}), "report")
+    optional = {
+        key: _section(cls, data[key], key) if key in data else None
+        for key, cls in (
+            ("devices", DevicesSpec),
+            ("synthesis", SynthesisSpec),
+            ("cameras", CamerasSpec),
+        )
+    }
+    if optional["devices"] and optional["devices"].noise not in VR_NOISE:
+        raise ScenarioError(f"devices.noise must be one of {VR_NOISE}")
+    if optional["synthesis"] and not optional["devices"]:
+        raise ScenarioError("[synthesis] needs a [devices] table (the VR stream it runs on)")
+    if optional["synthesis"] and optional["synthesis"].database_subjects < 1:
+        raise ScenarioError("synthesis.database_subjects must be at least 1")
     if motion.duration_s <= 0 or motion.fps <= 0:
         raise ScenarioError("motion.duration_s and motion.fps must be positive")
     if motion.height_m is not None and not 1.0 <= motion.height_m <= 2.5:
@@ -162,6 +217,7 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
         motion=motion,
         body=body,
         report=report,
+        **optional,
         thresholds=thresholds,
         physics=physics,
         path=path,

@@ -1,0 +1,36 @@
+"""Simulated VR tracking of the ground truth: headset and controllers (+ Vive trackers) at 90 Hz."""
+
+from __future__ import annotations
+
+from render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
+from render_cams.vr.noise import Drift, Latency, PositionJitter, RotationJitter
+from scripts.run_context import RunContext
+
+METRICS = {"vr_valid_frac": "share of valid VR samples over all devices"}
+
+# Lighthouse-grade jitter and drift (render_cams.vr.noise defaults) and one 90 Hz frame of
+# tracking latency; latency first, since it shifts whole samples.
+REALISTIC_NOISE = (Latency(seconds=1 / 90), PositionJitter(), RotationJitter(), Drift())
+
+
+def setup(ctx: RunContext) -> VRSetup:
+    spec = ctx.scenario.devices
+    devices = FULL_BODY if spec.trackers else HEADSET_AND_CONTROLLERS
+    noise = REALISTIC_NOISE if spec.noise == "realistic" else ()
+    return VRSetup(devices=devices, noise=noise)
+
+
+def run(ctx: RunContext) -> None:
+    if ctx.scenario.devices is None or not ctx.scenario.devices.vr:
+        return
+    vr = setup(ctx)
+    stream = vr.sample(ctx.motion, seed=ctx.scenario.seed)
+    ctx.artifacts["vr_stream"] = stream
+    ctx.metrics["vr_valid_frac"] = float(stream.valid.mean())
+    ctx.info["devices"] = {
+        "vr": list(stream.device_names),
+        "rate_hz": vr.rate_hz,
+        "samples": int(stream.timestamps.size),
+        "noise": ctx.scenario.devices.noise,
+    }
+    ctx.output("vr_stream", stream.to_npz(ctx.out_dir / "vr_stream.npz"))

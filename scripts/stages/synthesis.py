@@ -1,0 +1,91 @@
+"""Full-body synthesis from the VR stream, its accuracy against the ground truth (body17) and
+the physics plausibility of each method's output on the humanoid."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from avatar_models.generator import generate, sample_subject
+from avatar_models.measure import standing_height
+from avatar_models.motion import Motion
+from scripts.run_context import RunContext
+from scripts.scenario import ScenarioError
+from sim.plausibility import check_motion
+from synthesis.base import Synthesizer
+from synthesis.coolmoves import CoolMoves, Options, build_database
+from synthesis.coolmoves.accuracy import body17_errors_cm, hand_correlation
+
+METHODS = ("coolmoves", "ik")
+GROUPS = ("hands", "upper", "lower", "full")
+
+METRICS = {
+    **{
+        f"{m}_err_cm_{g}": f"{m}: mean body17 error of the {g} group (cm)"
+        for m in METHODS
+        for g in GROUPS
+    },
+    **{
+        f"{m}_hand_corr_min": f"{m}: Pearson r of input vs output hands, worse hand"
+        for m in METHODS
+    },
+    **{
+        f"{m}_skate_cm_s_median": f"{m}: stance foot skating of the output on the humanoid"
+        for m in METHODS
+    },
+    **{
+        f"{m}_penetration_cm_p95": f"{m}: floor penetration of the output on the humanoid"
+        for m in METHODS
+    },
+}
+
+
+def database_takes(ctx: RunContext) -> list[Motion]:
+    """Built-in takes of the scenario's activity by other subjects (not the user)."""
+    spec = ctx.scenario.synthesis
+    rng = np.random.default_rng([ctx.scenario.seed, 1])  # a stream apart from the user's
+    activity = ctx.info["motion"]["activity"] or "walk"
+    return [
+        generate(
+            activity, sample_subject(rng), spec.database_duration_s, 90.0, int(rng.integers(2**31))
+        )
+        for _ in range(spec.database_subjects)
+    ]
+
+
+def make_synthesizer(method: str, ctx: RunContext, user_height_m: float) -> Synthesizer:
+    if method == "coolmoves":
+        spec = ctx.scenario.synthesis
+        options = Options(foot_contact=spec.foot_contact, arm_ik=spec.arm_ik)
+        return CoolMoves(build_database(database_takes(ctx)), user_height_m, options)
+    if method == "ik":
+        from synthesis.ik_baseline import IKBaseline
+
+        # The IK baseline drives the same rig as the database, so errors compare like for like.
+        return IKBaseline(ctx.motion.skeleton, user_height_m=user_height_m)
+    raise ScenarioError(f"unknown synthesis method {method!r}; known: {', '.join(METHODS)}")
+
+
+def run(ctx: RunContext) -> None:
+    spec = ctx.scenario.synthesis
+    if spec is None:
+        return
+    stream = ctx.artifacts["vr_stream"]
+    subject = ctx.motion.meta.get("subject") or {}
+    user_height_m = subject.get("height_m") or standing_height(ctx.motion)
+    outputs: dict[str, Motion] = {}
+    for method in spec.methods:
+        output = make_synthesizer(method, ctx, user_height_m).run(stream)
+        outputs[method] = output
+        for group, value in body17_errors_cm(output, ctx.motion).items():
+            ctx.metrics[f"{method}_err_cm_{group}"] = value
+        corr = hand_correlation(output, stream)
+        ctx.metrics[f"{method}_hand_corr_min"] = min(corr.values())
+        physics = check_motion(output).values
+        ctx.metrics[f"{method}_skate_cm_s_median"] = physics["skate_cm_s_median"]
+        ctx.metrics[f"{method}_penetration_cm_p95"] = physics["penetration_cm_p95"]
+        ctx.info.setdefault("synthesis", {})[method] = {
+            "frames": output.n_frames,
+            "hand_corr": corr,
+            "err_cm": {g: ctx.metrics[f"{method}_err_cm_{g}"] for g in GROUPS},
+        }
+    ctx.artifacts["synthesised"] = outputs
