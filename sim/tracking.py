@@ -1,25 +1,36 @@
 """Physics tracking: the humanoid follows a reference ``qpos`` under simulation, root unactuated.
 
-Shapes: ``T`` reference frames, ``nq``/``nv``/``nu`` MuJoCo sizes, 17 body17 sites.
+Shapes: ``T`` reference frames, ``nq``/``nv``/``nu`` MuJoCo sizes, ``C`` floor contacts, 17
+body17 sites.
 
-Control, once per reference frame (held for the simulation steps in between):
+Controller: whole-body inverse dynamics with contact-force optimisation (the standard
+task-space / QP controller of legged robots and physics-based characters, e.g. de Lasa et al.
+2010 "Feature-based locomotion controllers"; Wensing & Orin 2013). At every control step:
 
-* PD on every hinge through the body's own position actuators (``kp``, ``kv`` from
-  :mod:`avatar_models.body.mjcf`): ``tau = kp (q_ref - q) + kv (qd_ref - qd)``;
-* inverse-dynamics feedforward: ``mj_inverse`` on the reference (``q``, ``qd``, ``qdd`` by
-  finite differences), keeping the hinge torques and dropping the root's 6 entries, which
-  no motor could produce;
+* desired accelerations of ALL ``nv`` dofs, root included:
+  ``qacc_des = qacc_ref + Kp (q_ref ⊖ q) + Kd (qvel_ref - qvel)`` (``mj_differentiatePos``
+  for the free joint), and for each foot a world-orientation task
+  ``J_rot qacc ≈ Kp_f log(R_ref Rᵀ) + Kd_f (w_ref - w)`` so a foot lands flat;
+* a QP over ``x = (qacc, lambda)`` with ``lambda >= 0`` the weights of the edges of a
+  linearised friction pyramid at each floor contact MuJoCo reports (feet within
+  :attr:`TrackingSettings.contact_margin` of the floor count, so the whole sole is usable):
 
-* balance (Yin et al. 2007, SIMBICON: stance-hip torque controls the torso): a PD torque
-  ``T = k_r e(R_ref R^T) + d_r (w_ref - w)`` on the root's world orientation, produced by
-  the hips of the legs the reference stands on, ``tau_hinge = -axis . T`` (the Jacobian
-  transpose, so the pelvis feels ``T`` as the reaction of internal joint torques);
+      min  |W (qacc - qacc_des)|² + w_f |J_rot qacc - a_f|² + w_c |J_c qacc + k_c J_c qvel|²
+           + w_lambda |lambda|²
+      s.t. M_root qacc + c_root = (J_cᵀ E lambda)_root        (the 6 unactuated rows)
 
-all enter as the actuator's set-point, ``ctrl = q_ref + (tau_ff + tau_bal + kv qd_ref) / kp``,
-so all joint torque is actuator force and is reported as such. The set-point may leave the joint
-range (a feedforward torque near a limit), so the tracking model copy lifts the actuators'
-``ctrlrange`` clamp; joint ranges themselves stay. Nothing acts on the root: no actuator on
-the free joint, ``xfrc_applied`` and ``qfrc_applied`` stay zero.
+  so the root's acceleration can come from contact forces only;
+* joint torques ``tau = (M qacc + c - J_cᵀ E lambda)_hinges`` are sent to the actuators,
+  switched to motors in the tracking model copy; MuJoCo then simulates the contacts itself.
+
+Foot placement (Yin et al. 2007, SIMBICON: ``theta_d = theta_0 + c_d d + c_v v``): a leg the
+reference swings has its hip target shifted by ``J_hip⁺ (c_d e + c_v e_dot)``, with ``e``
+the root's horizontal position error (simulated minus reference) and ``J_hip`` the ankle's
+horizontal Jacobian over the hip hinges, so the next stance foot lands where it can pull
+the body back onto the reference (capture-point feedback).
+
+Nothing acts on the root: no actuator on the free joint, ``xfrc_applied`` and
+``qfrc_applied`` stay zero (tested).
 
 A fall (after Peng et al. 2018, DeepMimic, whose episodes end when the character falls) is
 the first frame where the head is below :attr:`TrackingSettings.fall_head_ratio` of the
@@ -33,34 +44,68 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
+from qpsolvers import solve_qp
+from scipy.ndimage import gaussian_filter1d
 
 from avatar_models.body17 import BODY17
 from avatar_models.errors import MotionValueError
 
 ROOT_DOF = 6
+QP_SOLVER = "daqp"
+FEET = ("Bip01 L Foot", "Bip01 R Foot")
+THIGHS = ("Bip01 L Thigh", "Bip01 R Thigh")
+ANKLE_SITES = ("l_ankle", "r_ankle")
 
 
 @dataclass(frozen=True)
 class TrackingSettings:
-    """Controller and fall criteria.
+    """Controller gains, QP weights and fall criteria (accelerations in rad/s² or m/s²).
 
     Attributes:
-        feedforward: add the inverse-dynamics hinge torques of the reference.
-        gain_scale: factor on the actuators' ``kp`` and ``kv``.
+        kp, kd: hinge stiffness (1/s²) and damping (1/s) of ``qacc_des``.
+        kp_root, kd_root: the same for the root's 6 dofs.
+        kp_root_xy: root stiffness along world X and Y (drift is corrected by stepping).
+        root_weight: QP weight of the root rows relative to a hinge's 1.
+        foot_weight, kp_foot, kd_foot: world-orientation task of each foot.
+        contact_weight, contact_damping: ``|J_c qacc + k_c J_c qvel|²`` keeps a contact still.
+        force_weight: regularisation of the friction-pyramid weights (1/N²).
+        friction: cone coefficient of the QP, below the geoms' 1.0 for a margin.
+        contact_margin: a foot within this of the floor (m) offers contacts to the QP.
+        level_stance_feet: aim a foot the reference stands on flat (see ``_foot_tasks``).
+        step_position_gain, step_velocity_gain: SIMBICON ``c_d`` (m/m), ``c_v`` (s).
+        max_step_shift: bound on the foot-placement shift (m).
+        swing_ramp_s: the shift fades in over this time after lift-off.
+        stance_height: a reference foot stands while its ankle is within this of its lowest
+            height in the clip (m).
+        smoothing_frames: Gaussian sigma (frames) on the reference velocities and
+            accelerations (finite differences of mocap are noisy).
+        control_period: simulation steps per controller update (torques held in between).
         fall_head_ratio: fall when head height < this x the reference head height.
         fall_tilt_deg: fall when the root's up axis is this far from the reference's.
-        balance_gain: root orientation stiffness ``k_r`` as a multiple of ``m g H`` (N m/rad
-            for body mass ``m``, stature ``H``); 0 turns balance off.
-        balance_damping_s: ``d_r / k_r``.
-        stance_height: a foot stands in the reference while its ankle site is within this of
-            the ankle's lowest height in the clip (metres). ``H`` is the rest head height.
     """
 
-    feedforward: bool = True
-    gain_scale: float = 1.0
-    balance_gain: float = 1.0
-    balance_damping_s: float = 0.1
+    kp: float = 400.0
+    kd: float = 40.0
+    kp_root: float = 100.0
+    kp_root_xy: float = 0.0
+    kd_root: float = 20.0
+    root_weight: float = 10.0
+    foot_weight: float = 30.0
+    kp_foot: float = 400.0
+    kd_foot: float = 40.0
+    contact_weight: float = 100.0
+    contact_damping: float = 20.0
+    force_weight: float = 1e-6
+    friction: float = 0.8
+    contact_margin: float = 0.005
+    level_stance_feet: bool = False
+    step_position_gain: float = 0.5
+    step_velocity_gain: float = 0.2
+    max_step_shift: float = 0.25
+    swing_ramp_s: float = 0.15
     stance_height: float = 0.03
+    smoothing_frames: float = 1.0
+    control_period: int = 1
     fall_head_ratio: float = 0.6
     fall_tilt_deg: float = 60.0
 
@@ -115,18 +160,69 @@ class TrackingResult:
         }
 
 
-def reference_velocities(model: mujoco.MjModel, qpos: np.ndarray, fps: float) -> np.ndarray:
-    """``(T, nv)`` velocities of ``qpos (T, nq)`` by central differences on the manifold
-    (``mj_differentiatePos``, so the root quaternion is handled)."""
+def forward_differences(model: mujoco.MjModel, qpos: np.ndarray, fps: float) -> np.ndarray:
+    """``(T, nv)`` velocity from each frame to the next (the last repeats the one before),
+    on the manifold (``mj_differentiatePos``, so the root quaternion is handled)."""
     n = qpos.shape[0]
-    dt = 1.0 / fps
     forward = np.zeros((n, model.nv))
     for t in range(n - 1):  # one MuJoCo call per frame pair
-        mujoco.mj_differentiatePos(model, forward[t], dt, qpos[t], qpos[t + 1])
+        mujoco.mj_differentiatePos(model, forward[t], 1.0 / fps, qpos[t], qpos[t + 1])
     if n > 1:
         forward[-1] = forward[-2]
-    backward = np.vstack([forward[:1], forward[:-1]])
-    return 0.5 * (forward + backward)
+    return forward
+
+
+def reference_velocities(model: mujoco.MjModel, qpos: np.ndarray, fps: float) -> np.ndarray:
+    """``(T, nv)`` velocities of ``qpos (T, nq)`` by central differences on the manifold."""
+    forward = forward_differences(model, qpos, fps)
+    return 0.5 * (forward + np.vstack([forward[:1], forward[:-1]]))
+
+
+def looped(qpos: np.ndarray, fps: float, duration_s: float, min_cycle_s: float = 0.8):
+    """``(T', nq)`` the clip ``qpos (T, nq)`` played once, then its best gait cycle repeated
+    until it lasts ``duration_s``.
+
+    The cycle is the frame pair ``i < j`` (``j - i >= min_cycle_s``) whose hinge angles and
+    hinge velocities match best; each repetition of frames ``[i, j)`` is moved by the
+    horizontal rigid motion (yaw about Z, translation in XY) that takes the root at ``i`` to
+    the root at ``j``, so the walk continues where it left off.
+    """
+    n, need = qpos.shape[0], int(np.ceil(duration_s * fps)) + 1
+    if n >= need:
+        return qpos[:need]
+    hinge = qpos[:, 7:]
+    feature = np.hstack([hinge, np.gradient(hinge, axis=0) * 3.0, qpos[:, 2:3] * 10.0])
+    dist = np.linalg.norm(feature[:, None] - feature[None], axis=-1)
+    gap = np.arange(n)[None] - np.arange(n)[:, None]
+    dist[gap < min_cycle_s * fps] = np.inf
+    i, j = np.unravel_index(np.argmin(dist), dist.shape)
+    if not np.isfinite(dist[i, j]):
+        raise MotionValueError(f"clip too short to loop: {n} frames at {fps} fps")
+    turn = _yaw(qpos[j, 3:7]) - _yaw(qpos[i, 3:7])
+    rot = np.array([[np.cos(turn), -np.sin(turn)], [np.sin(turn), np.cos(turn)]])
+    pieces = [qpos[:j]]
+    repeat = qpos[i:j].copy()
+    for _ in range(int(np.ceil((need - j) / (j - i)))):
+        repeat = repeat.copy()
+        repeat[:, :2] = (repeat[:, :2] - qpos[i, :2]) @ rot.T + qpos[j, :2]
+        repeat[:, 3:7] = _yaw_quat(turn, repeat[:, 3:7])
+        pieces.append(repeat)
+    return np.vstack(pieces)[:need]
+
+
+def _yaw(q: np.ndarray) -> float:
+    """Heading (rad) of the root's local +X for a wxyz quaternion."""
+    w, x, y, z = q
+    return float(np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
+
+
+def _yaw_quat(angle: float, quats: np.ndarray) -> np.ndarray:
+    """``(T, 4)`` ``quats`` turned by ``angle`` about world Z (wxyz)."""
+    turn = np.array([np.cos(angle / 2), 0.0, 0.0, np.sin(angle / 2)])
+    out = np.empty_like(quats)
+    for t in range(quats.shape[0]):  # mju_mulQuat is one quaternion per call
+        mujoco.mju_mulQuat(out[t], turn, quats[t])
+    return out
 
 
 class Tracker:
@@ -136,114 +232,122 @@ class Tracker:
     def __init__(self, model: mujoco.MjModel, settings: TrackingSettings | None = None):
         if model.nu == 0 or np.any(model.jnt_type[model.actuator_trnid[:, 0]] == 0):
             raise MotionValueError("tracking needs hinge actuators and no actuator on the root")
-        self.settings = settings or TrackingSettings()
+        self.settings = s = settings or TrackingSettings()
         self.model = model
-        self.model.actuator_ctrllimited[:] = 0  # set-points carry feedforward (module doc)
-        scale = self.settings.gain_scale
-        self.kp = model.actuator_gainprm[:, 0] * scale
-        self.kv = -model.actuator_biasprm[:, 2] * scale
-        model.actuator_gainprm[:, 0] = self.kp
-        model.actuator_biasprm[:, 1] = -self.kp
-        model.actuator_biasprm[:, 2] = -self.kv
+        # The tracking copy's actuators become motors (ctrl = torque, no clamp), and geoms
+        # report floor contacts within the margin without acting on them (gap = margin).
+        model.actuator_gainprm[:] = 0.0
+        model.actuator_gainprm[:, 0] = 1.0
+        model.actuator_biasprm[:] = 0.0
+        model.actuator_ctrllimited[:] = 0
+        model.geom_margin[:] = s.contact_margin
+        model.geom_gap[:] = s.contact_margin
         self.data = mujoco.MjData(model)
         self.dof = model.jnt_dofadr[model.actuator_trnid[:, 0]]
-        self.qadr = model.jnt_qposadr[model.actuator_trnid[:, 0]]
         self.sites = np.array(
             [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, n) for n in BODY17]
         )
-        self.hips = [self._body_actuators(side) for side in ("l_hip", "r_hip")]
-        weight = float(model.body_subtreemass[1]) * float(-model.opt.gravity[2])
-        mujoco.mj_kinematics(model, self.data)  # qpos0: standing on the floor in rest pose
-        height = float(self.data.site_xpos[self.sites[BODY17.index("head")], 2])
-        self.balance_kp = self.settings.balance_gain * weight * height
-        self.balance_kd = self.balance_kp * self.settings.balance_damping_s
+        self.ankles = np.array(
+            [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, n) for n in ANKLE_SITES]
+        )
+        self.feet = [model.body(name).id for name in FEET]
+        hips = [np.flatnonzero(model.jnt_bodyid == model.body(name).id) for name in THIGHS]
+        self.hip_dof = [model.jnt_dofadr[j] for j in hips]
+        self.hip_qadr = [model.jnt_qposadr[j] for j in hips]
+        self.floor = [g for g in range(model.ngeom) if model.geom_bodyid[g] == 0]
+        nv = model.nv
+        self.kp = np.full(nv, s.kp)
+        self.kd = np.full(nv, s.kd)
+        self.kp[:ROOT_DOF], self.kd[:ROOT_DOF] = s.kp_root, s.kd_root
+        self.kp[:2] = s.kp_root_xy
+        self.weight = np.ones(nv)
+        self.weight[:ROOT_DOF] = s.root_weight
+        rest = mujoco.MjData(model)
+        mujoco.mj_kinematics(model, rest)  # qpos0 stands flat-footed on the floor
+        self.sole_normal = [rest.xmat[b].reshape(3, 3)[2] for b in self.feet]  # R^T z
+        mu = s.friction
+        # Friction-pyramid edges in the contact frame (normal, tangent 1, tangent 2).
+        self.edges = np.array([[1, mu, 0], [1, -mu, 0], [1, 0, mu], [1, 0, -mu]], float).T
 
-    def _body_actuators(self, site: str) -> np.ndarray:
-        """Actuators of the hinges of the body that carries body17 ``site``."""
-        body = self.model.site_bodyid[self.sites[BODY17.index(site)]]
-        return np.flatnonzero(self.model.jnt_bodyid[self.model.actuator_trnid[:, 0]] == body)
-
-    def stance(self, ref_sites: np.ndarray) -> np.ndarray:
-        """``(T, 2)`` weight of the left and right leg in the reference's support (0..1)."""
-        ankles = ref_sites[:, [BODY17.index("l_ankle"), BODY17.index("r_ankle")], 2]
-        down = ankles < ankles.min(axis=0) + self.settings.stance_height
-        total = down.sum(axis=1, keepdims=True)
-        return np.divide(down, total, out=np.zeros(down.shape), where=total > 0)
-
-    def balance_torque(self, quat_ref: np.ndarray, omega_ref: np.ndarray, stance) -> np.ndarray:
-        """``(nu,)`` stance-hip hinge torques that turn the root towards ``quat_ref`` (wxyz),
-        at world angular velocity ``omega_ref``; see the module docstring."""
-        d = self.data
-        err_quat = np.empty(4)
-        conj = np.empty(4)
-        mujoco.mju_negQuat(conj, d.qpos[3:7])
-        mujoco.mju_mulQuat(err_quat, quat_ref, conj)
-        err = np.empty(3)
-        mujoco.mju_quat2Vel(err, err_quat, 1.0)
-        omega = d.xmat[1].reshape(3, 3) @ d.qvel[3:6]
-        torque = self.balance_kp * err + self.balance_kd * (omega_ref - omega)
-        out = np.zeros(self.model.nu)
-        axes = d.xaxis[self.model.actuator_trnid[:, 0]]
-        for weight, hip in zip(stance, self.hips, strict=True):
-            out[hip] = -weight * (axes[hip] @ torque)
-        return out
-
-    def feedforward(self, qpos: np.ndarray, qvel: np.ndarray, fps: float) -> np.ndarray:
-        """``(T, nu)`` hinge torques from ``mj_inverse`` on the reference (root dropped)."""
-        qacc = np.gradient(qvel, 1.0 / fps, axis=0) if qpos.shape[0] > 1 else 0 * qvel
-        data = mujoco.MjData(self.model)
-        out = np.empty((qpos.shape[0], self.model.nu))
-        for t in range(qpos.shape[0]):  # MuJoCo evaluates one state per call
-            data.qpos[:], data.qvel[:], data.qacc[:] = qpos[t], qvel[t], qacc[t]
-            mujoco.mj_inverse(self.model, data)
-            out[t] = data.qfrc_inverse[self.dof]
-        return out
+    def swing_weights(self, qpos: np.ndarray, fps: float) -> np.ndarray:
+        """``(T, 2)`` 0..1 weight of the foot-placement shift per leg (left, right): 0 while
+        the reference foot stands, ramping to 1 over ``swing_ramp_s`` after lift-off."""
+        ankles = self._site_positions(qpos, self.ankles)[..., 2]
+        swing = ankles >= ankles.min(axis=0) + self.settings.stance_height
+        since = np.zeros(swing.shape)
+        for t in range(1, swing.shape[0]):  # a running count: sequential by definition
+            since[t] = np.where(swing[t], since[t - 1] + 1.0 / fps, 0.0)
+        ramp = max(self.settings.swing_ramp_s, 1e-9)
+        return np.where(swing, np.clip(since / ramp, 1.0 / (ramp * fps), 1.0), 0.0)
 
     def reference_sites(self, qpos: np.ndarray) -> np.ndarray:
         """``(T, 17, 3)`` body17 site positions of ``qpos (T, nq)`` (kinematics only)."""
+        return self._site_positions(qpos, self.sites)
+
+    def _site_positions(self, qpos: np.ndarray, sites: np.ndarray) -> np.ndarray:
         data = mujoco.MjData(self.model)
-        out = np.empty((qpos.shape[0], len(BODY17), 3))
-        for t in range(qpos.shape[0]):
+        out = np.empty((qpos.shape[0], sites.size, 3))
+        for t in range(qpos.shape[0]):  # MuJoCo evaluates one state per call
             data.qpos[:] = qpos[t]
             mujoco.mj_kinematics(self.model, data)
-            out[t] = data.site_xpos[self.sites]
+            out[t] = data.site_xpos[sites]
         return out
 
     def run(self, qpos_ref: np.ndarray, fps: float) -> TrackingResult:
-        """Track ``qpos_ref (T, nq)`` sampled at ``fps`` from its first frame, at rest-free
-        initial velocity equal to the reference's."""
+        """Track ``qpos_ref (T, nq)`` sampled at ``fps`` from its first frame and velocity.
+        The reference is interpolated at every simulation step (on the manifold)."""
         qpos_ref = np.asarray(qpos_ref, dtype=float)
-        m, d = self.model, self.data
+        m, d, s = self.model, self.data, self.settings
         if qpos_ref.ndim != 2 or qpos_ref.shape[1] != m.nq or not np.isfinite(qpos_ref).all():
             raise MotionValueError(f"reference must be finite (T, {m.nq}), got {qpos_ref.shape}")
+        if qpos_ref.shape[0] < 2:
+            raise MotionValueError("reference must have at least 2 frames")
         n = qpos_ref.shape[0]
+        forward = forward_differences(m, qpos_ref, fps)
         qvel_ref = reference_velocities(m, qpos_ref, fps)
-        hinge_v = qvel_ref[:, self.dof]
-        tau_ff = self.feedforward(qpos_ref, qvel_ref, fps) if self.settings.feedforward else 0.0
-        ctrl = qpos_ref[:, self.qadr] + (tau_ff + self.kv * hinge_v) / self.kp
-        substeps = max(1, round(1.0 / (fps * m.opt.timestep)))
+        sigma = s.smoothing_frames
+        if sigma > 0:
+            qvel_ref = gaussian_filter1d(qvel_ref, sigma, axis=0, mode="nearest")
+        qacc_ref = np.gradient(qvel_ref, 1.0 / fps, axis=0)
+        if sigma > 0:
+            qacc_ref = gaussian_filter1d(qacc_ref, sigma, axis=0, mode="nearest")
+        swing = self.swing_weights(qpos_ref, fps)
         ref_sites = self.reference_sites(qpos_ref)
-        stance = self.stance(ref_sites)
-        omega_ref = self._world_angular_velocity(qpos_ref, qvel_ref)
-        balance = self.settings.balance_gain > 0
 
         mujoco.mj_resetData(m, d)
         d.qpos[:], d.qvel[:] = qpos_ref[0], qvel_ref[0]
+        mujoco.mj_step1(m, d)
+        self._ref_data = mujoco.MjData(m)
         qpos = np.empty((n, m.nq))
         sites = np.empty((n, len(BODY17), 3))
-        torque = np.empty((n, m.nu))
-        power = np.empty(n)
-        for t in range(n):  # the simulation is sequential by nature
-            for _ in range(substeps):
-                d.ctrl[:] = ctrl[t]
-                if balance:
-                    tau = self.balance_torque(qpos_ref[t, 3:7], omega_ref[t], stance[t])
-                    d.ctrl[:] += tau / self.kp
-                mujoco.mj_step(m, d)
-            qpos[t] = d.qpos
-            sites[t] = d.site_xpos[self.sites]
-            torque[t] = d.actuator_force
-            power[t] = np.abs(d.actuator_force * d.qvel[self.dof]).sum()
+        torque = np.zeros((n, m.nu))
+        power = np.zeros(n)
+        qpos[0], sites[0] = d.qpos, d.site_xpos[self.sites]
+        steps = int(np.ceil((n - 1) / (fps * m.opt.timestep) - 1e-9))
+        frame_of_step = np.floor(np.arange(1, steps + 1) * m.opt.timestep * fps + 1e-9).astype(int)
+        q_target = np.empty(m.nq)
+        tau = np.zeros(m.nu)
+        for k in range(steps):  # the simulation is sequential by nature
+            if k % s.control_period == 0:
+                phase = k * m.opt.timestep * fps
+                i = min(int(phase), n - 2)
+                a = min(phase - i, 1.0)
+                q_target[:] = qpos_ref[i]
+                mujoco.mj_integratePos(m, q_target, forward[i], a / fps)
+                v_target = (1 - a) * qvel_ref[i] + a * qvel_ref[i + 1]
+                a_target = (1 - a) * qacc_ref[i] + a * qacc_ref[i + 1]
+                swinging = (1 - a) * swing[i] + a * swing[i + 1]
+                self._place_feet(q_target, v_target, swinging)
+                standing = (swinging == 0) & s.level_stance_feet
+                tau = self._torques(q_target, v_target, a_target, standing)
+            d.ctrl[:] = tau
+            mujoco.mj_step2(m, d)
+            mujoco.mj_step1(m, d)
+            t = frame_of_step[k]
+            if t < n and (k == 0 or frame_of_step[k - 1] != t):
+                qpos[t], sites[t] = d.qpos, d.site_xpos[self.sites]
+                torque[t] = d.actuator_force
+                power[t] = np.abs(d.actuator_force * d.qvel[self.dof]).sum()
         return TrackingResult(
             qpos=qpos,
             body17_error=np.linalg.norm(sites - ref_sites, axis=-1),
@@ -253,13 +357,98 @@ class Tracker:
             fps=fps,
         )
 
-    def _world_angular_velocity(self, qpos: np.ndarray, qvel: np.ndarray) -> np.ndarray:
-        """``(T, 3)`` world angular velocity of the root (MuJoCo's free-joint angular
-        velocity is in the root's local frame)."""
-        mats = np.empty((qpos.shape[0], 9))
-        for t in range(qpos.shape[0]):
-            mujoco.mju_quat2Mat(mats[t], qpos[t, 3:7])
-        return np.einsum("tab,tb->ta", mats.reshape(-1, 3, 3), qvel[:, 3:6])
+    def _place_feet(self, q_target: np.ndarray, v_target: np.ndarray, swing: np.ndarray):
+        """Shift the swinging hips' targets in ``q_target`` (in place); module docstring."""
+        s, d = self.settings, self.data
+        shift = s.step_position_gain * (d.qpos[:2] - q_target[:2]) + s.step_velocity_gain * (
+            d.qvel[:2] - v_target[:2]
+        )
+        norm = np.linalg.norm(shift)
+        if norm > s.max_step_shift:
+            shift *= s.max_step_shift / norm
+        jac = np.zeros((3, self.model.nv))
+        for side in np.flatnonzero(swing > 0):
+            mujoco.mj_jacSite(self.model, d, jac, None, self.ankles[side])
+            j = jac[:2, self.hip_dof[side]]
+            dq = j.T @ np.linalg.solve(j @ j.T + 1e-4 * np.eye(2), shift)  # damped pseudo-inverse
+            q_target[self.hip_qadr[side]] += swing[side] * dq
+
+    def _torques(self, q_target, v_target, a_target, standing) -> np.ndarray:
+        """``(nu,)`` hinge torques of the whole-body QP (module docstring)."""
+        m, d, s = self.model, self.data, self.settings
+        nv = m.nv
+        error = np.empty(nv)
+        mujoco.mj_differentiatePos(m, error, 1.0, d.qpos, q_target)
+        qacc_des = a_target + self.kp * error + self.kd * (v_target - d.qvel)
+        mass = np.empty((nv, nv))
+        mujoco.mj_fullM(m, d, mass)
+        bias = d.qfrc_bias
+        jc, je = self._contacts()
+        nx = nv + je.shape[1]
+        hess = np.zeros((nx, nx))
+        grad = np.zeros(nx)
+        hess[:nv, :nv] = np.diag(self.weight)
+        grad[:nv] = -self.weight * qacc_des
+        for jr, acc in self._foot_tasks(q_target, v_target, standing):
+            hess[:nv, :nv] += s.foot_weight * jr.T @ jr
+            grad[:nv] -= s.foot_weight * jr.T @ acc
+        if je.shape[1]:
+            hess[:nv, :nv] += s.contact_weight * jc.T @ jc
+            grad[:nv] += s.contact_weight * jc.T @ (s.contact_damping * (jc @ d.qvel))
+            hess[nv:, nv:] = s.force_weight * np.eye(je.shape[1])
+        eq = np.hstack([mass[:ROOT_DOF], -je[:ROOT_DOF]])
+        lower = np.full(nx, -np.inf)
+        lower[nv:] = 0.0
+        x = solve_qp(hess, grad, A=eq, b=-bias[:ROOT_DOF], lb=lower, solver=QP_SOLVER)
+        if x is None:  # no solution: hold the pose with gravity compensation only
+            x = np.concatenate([np.zeros(nv), np.zeros(je.shape[1])])
+        generalised = mass @ x[:nv] + bias - je @ x[nv:]
+        return generalised[self.dof]
+
+    def _contacts(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(3C, nv)`` Jacobian of the floor contact points and ``(nv, 4C)`` generalised
+        forces of their friction-pyramid edges."""
+        m, d = self.model, self.data
+        pairs = [
+            (c, c.geom2 if c.geom1 in self.floor else c.geom1)
+            for c in d.contact[: d.ncon]
+            if (c.geom1 in self.floor) != (c.geom2 in self.floor)
+        ]
+        jc = np.zeros((3 * len(pairs), m.nv))
+        je = np.zeros((m.nv, 4 * len(pairs)))
+        for n, (c, geom) in enumerate(pairs):
+            jac = jc[3 * n : 3 * n + 3]
+            mujoco.mj_jac(m, d, jac, None, c.pos, m.geom_bodyid[geom])
+            frame = c.frame.reshape(3, 3)  # rows: normal (from geom1 to geom2), tangents
+            if c.geom2 in self.floor:
+                frame = -frame
+            je[:, 4 * n : 4 * n + 4] = jac.T @ (frame.T @ self.edges)
+        return jc, je
+
+    def _foot_tasks(self, q_target, v_target, standing):
+        """Per foot: ``(3, nv)`` rotational Jacobian and the desired angular acceleration
+        towards the reference foot's orientation, levelled (sole normal turned onto +Z by
+        the smallest rotation) while the reference stands on it: retargeted clips often
+        stand on a tilted sole, which would leave one edge of the foot on the floor."""
+        m, d, s, ref = self.model, self.data, self.settings, self._ref_data
+        ref.qpos[:] = q_target
+        mujoco.mj_kinematics(m, ref)
+        mujoco.mj_comPos(m, ref)
+        jr, jr_ref = np.zeros((3, m.nv)), np.zeros((3, m.nv))
+        conj, err_quat, err = np.empty(4), np.empty(4), np.empty(3)
+        target, level = np.empty(4), np.empty(4)
+        for body, normal, stand in zip(self.feet, self.sole_normal, standing, strict=True):
+            mujoco.mj_jacBody(m, d, None, jr, body)
+            mujoco.mj_jacBody(m, ref, None, jr_ref, body)
+            target[:] = ref.xquat[body]
+            if stand:
+                mujoco.mju_quatZ2Vec(level, ref.xmat[body].reshape(3, 3) @ normal)
+                mujoco.mju_negQuat(level, level)
+                mujoco.mju_mulQuat(target, level, ref.xquat[body])
+            mujoco.mju_negQuat(conj, d.xquat[body])
+            mujoco.mju_mulQuat(err_quat, target, conj)
+            mujoco.mju_quat2Vel(err, err_quat, 1.0)
+            yield jr.copy(), s.kp_foot * err + s.kd_foot * (jr_ref @ v_target - jr @ d.qvel)
 
     def _fall_frame(self, qpos, qpos_ref, sites, ref_sites) -> int | None:
         head = BODY17.index("head")

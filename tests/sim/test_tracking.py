@@ -1,4 +1,5 @@
-"""Physics tracking: the root is never actuated, standing holds, falls are detected."""
+"""Physics tracking: the root is never actuated, standing holds, the walk is tracked, falls are
+detected, looping a clip continues the walk."""
 
 from __future__ import annotations
 
@@ -10,7 +11,9 @@ from avatar_models.body.ik import humanoid_model
 from avatar_models.errors import MotionValueError
 from avatar_models.generator import generate
 from avatar_models.rigs import load_rig
-from sim.tracking import Tracker, TrackingSettings, track
+from sim.tracking import Tracker, TrackingSettings, looped, track
+
+BANDAI_WALK = "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh"
 
 
 @pytest.fixture(scope="module")
@@ -18,54 +21,97 @@ def body():
     return build_body(load_rig("avatar").skeleton)
 
 
-def test_root_is_unactuated(body):
+class _RootWatch(Tracker):
+    """A tracker that checks, before every simulation step, that nothing pushes the root."""
+
+    def _torques(self, *args):
+        d = self.data
+        assert not d.xfrc_applied.any()
+        assert not d.qfrc_applied.any()
+        assert not d.qfrc_actuator[:6].any()  # the actuators move hinges only
+        return super()._torques(*args)
+
+
+def test_root_is_unactuated_while_walking(body):
     model = humanoid_model(body)
-    tracker = Tracker(model)
     free = np.flatnonzero(model.jnt_type == 0)
     assert free.tolist() == [0]
     assert not np.isin(model.actuator_trnid[:, 0], free).any()
-    tracker.run(np.tile(model.qpos0, (30, 1)), 30.0)
-    assert not tracker.data.xfrc_applied.any()
-    assert not tracker.data.qfrc_applied.any()
+    walk = generate("walk", duration_s=0.5, fps=30.0)
+    tracker = _RootWatch(model)
+    result = tracker.run(body.qpos_from_motion(walk), walk.fps)
+    assert not tracker.data.xfrc_applied.any() and not tracker.data.qfrc_applied.any()
+    assert result.torque.any()
 
 
-def test_standing_still_holds_for_3_s(body):
+def test_standing_still_holds_for_2_s(body):
     model = humanoid_model(body)
-    result = track(model, np.tile(model.qpos0, (91, 1)), 30.0)
+    result = track(model, np.tile(model.qpos0, (61, 1)), 30.0)
     assert not result.fell
-    assert result.body17_error.mean() < 0.02  # metres
-    summary = result.summary()
-    assert summary["energy_j"] >= 0 and summary["mean_abs_torque_nm"] > 1.0  # holds itself up
+    assert result.body17_error.mean() < 0.01  # metres
+    assert result.summary()["mean_abs_torque_nm"] > 1.0  # it holds itself up
 
 
-def test_walk_first_second_is_tracked(body):
-    walk = generate("walk", duration_s=1.0, fps=30.0)
+def test_walk_3_s_without_falling(body):
+    walk = generate("walk", duration_s=3.0, fps=30.0)
     result = track(humanoid_model(body), body.qpos_from_motion(walk), walk.fps)
-    assert not result.fell
-    assert result.body17_error.mean() < 0.12
+    summary = result.summary()
+    assert not result.fell, summary
+    assert summary["body17_err_cm_mean"] < 10.0
 
 
-def test_limp_body_falls_and_is_detected(body):
-    model = humanoid_model(body)
-    limp = TrackingSettings(feedforward=False, gain_scale=0.01, balance_gain=0.0)
-    result = track(model, np.tile(model.qpos0, (91, 1)), 30.0, limp)
+def test_open_loop_body_falls_and_is_detected(body):
+    """Torques computed once and never updated cannot balance a walk."""
+    walk = generate("walk", duration_s=3.0, fps=30.0)
+    blind = TrackingSettings(control_period=10**9)
+    result = track(humanoid_model(body), body.qpos_from_motion(walk), walk.fps, blind)
     assert result.fell and 0.0 < result.fall_time_s < 3.0
 
 
 def test_bad_reference_is_refused(body):
     model = humanoid_model(body)
-    with pytest.raises(MotionValueError, match="reference must be"):
+    with pytest.raises(MotionValueError, match="reference must"):
         track(model, np.full((3, model.nq), np.nan), 30.0)
+    with pytest.raises(MotionValueError, match="at least 2 frames"):
+        track(model, model.qpos0[None], 30.0)
+
+
+def test_looped_clip_continues_the_walk(body):
+    """A 2 s walk looped to 5 s keeps moving forward at the clip's speed, without jumps."""
+    walk = generate("walk", duration_s=2.0, fps=30.0)
+    qpos = body.qpos_from_motion(walk)
+    out = looped(qpos, walk.fps, 5.0)
+    assert out.shape == (151, qpos.shape[1])
+    np.testing.assert_array_equal(out[:24], qpos[:24])  # the clip plays first (cycle >= 0.8 s)
+    step = np.linalg.norm(np.diff(out[:, :2], axis=0), axis=1)
+    speed = np.linalg.norm(np.diff(qpos[:, :2], axis=0), axis=1)
+    assert step.max() < 2.0 * speed.max()  # no seam jump
+    assert out[-1, 0] > 2.3 * qpos[-1, 0]  # 5 s of walking go 2.5x as far as 2 s
+
+
+def _summary_line(name, result):
+    s = result.summary()
+    print(name, {k: s[k] for k in ("fell", "fall_time_s", "body17_err_cm_mean")})
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(
-    strict=True,
-    reason="PD + inverse dynamics + stance-hip balance falls after ~1.3 s of "
-    "walking: no foot-placement feedback yet",
-)
+@pytest.mark.xfail(strict=True, reason="falls after ~6 s: lateral drift outgrows foot placement")
 def test_walk_10_s_without_falling(body):
     walk = generate("walk", duration_s=10.0, fps=30.0)
     result = track(humanoid_model(body), body.qpos_from_motion(walk), walk.fps)
-    print(result.summary())
+    _summary_line("builtin walk", result)
+    assert not result.fell
+
+
+@pytest.mark.slow
+@pytest.mark.mocap
+@pytest.mark.xfail(strict=True, reason="retargeted Bandai walk falls in ~1 s (stands on toes)")
+def test_bandai_walk_10_s_without_falling(mocap_dir):
+    from avatar_models.formats import load_motion
+    from sim.retarget import retarget
+
+    walk = retarget(load_motion(mocap_dir / BANDAI_WALK))
+    qpos = looped(walk.qpos, walk.motion.fps, 10.0)
+    result = track(humanoid_model(build_body(walk.motion.skeleton)), qpos, walk.motion.fps)
+    _summary_line("bandai walk", result)
     assert not result.fell
