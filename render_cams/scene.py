@@ -1,18 +1,22 @@
 """``BodyScene``: the posed body, a floor and lights, rendered headless with pyrender.
 
 The body is the same :class:`~avatar_models.body.BodyDescription` as the physics humanoid: each
-segment (capsule, box, sphere) is tessellated once in its body frame. It is in the scene twice:
+segment (capsule, box, sphere) is tessellated once in its body frame, and the segments are
+merged into ONE mesh (per-vertex colours, and per-vertex part labels in ``texcoord_1``) that
+is posed by transforming its vertices: pyrender spends ~0.2 ms of Python per drawn primitive,
+so one draw call instead of ~25 per view.
 
-- one node per segment, posed by one 4x4 each, drawn only by segmentation passes
-  (:meth:`BodyScene.render_parts`, which needs a label per segment) and by callers that
-  render ``BodyScene.scene`` themselves;
-- one merged mesh with per-vertex colours, drawn by :meth:`BodyScene.render`: pyrender spends
-  ~0.2 ms of Python per drawn primitive, so one draw call instead of ~25 per view. Posing
-  re-uploads its vertices (a few thousand, once per pose, on the next render).
+Passes (one GL context per scene, single-sampled unless ``antialias=True``):
 
-Colour passes use a diffuse-only shader (``shaders/matte.frag``; ``shading="pbr"`` keeps
-pyrender's physically based one). The headless OpenGL backend (EGL, OSMesa as fallback) is
-chosen in :mod:`avatar_models` before pyrender is imported.
+- :meth:`BodyScene.render`: colour and depth, with a diffuse-only shader
+  (``shaders/matte.frag``; ``shading="pbr"`` keeps pyrender's physically based one);
+- :meth:`BodyScene.render_depth_and_parts`: depth and part labels from ONE flat segmentation
+  pass (``shaders/labels.*``) that draws every mesh, so labels and depth agree at every pixel.
+
+Single sampling puts every sample at the pixel centre. pyrender's default 4x multisampling
+resolves depth by taking one sample, about 0.37 px off the centre, and blends label colours
+at silhouettes. The headless OpenGL backend (EGL, OSMesa as fallback) is chosen in
+:mod:`avatar_models` before pyrender is imported.
 
 Camera convention (OpenCV): x right, y down, z forward (the optical axis). A camera is given by
 its pose ``camera_to_world`` (4x4, camera axes as columns of the rotation, its centre as the
@@ -21,20 +25,19 @@ coordinates, ``X_cam = R.T @ (X_world - t)``. Pixel ``(u, v)`` has its centre at
 coordinates, as in OpenCV (``u = fx * x / z + cx``). Depth is the camera-frame ``z`` in metres,
 0 where nothing was hit.
 
-Labels of :meth:`BodyScene.render_parts`: 0 is background (floor, room, nothing), ``k + 1`` is
-body segment ``k`` (:attr:`BodyScene.part_names`), so ``parts > 0`` is a body-index map.
+Part labels: 0 is background (floor, room, nothing), ``k + 1`` is body segment ``k``
+(:attr:`BodyScene.part_names`), so ``parts > 0`` is a body-index map.
 """
 
 from __future__ import annotations
 
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import cv2
 import numpy as np
 import pyrender
 import trimesh
+from OpenGL import GL
 from pyrender.shader_program import ShaderProgramCache
 
 import avatar_models  # noqa: F401  (picks the OpenGL backend before pyrender loads)
@@ -47,7 +50,10 @@ from avatar_models.skeleton import Skeleton
 CV_TO_GL = np.diag([1.0, -1.0, -1.0, 1.0])
 Z_NEAR_M = 0.01  # a controller camera can be a few cm from the hand holding it
 Z_FAR_M = 50.0
-MATTE_SHADER = Path(__file__).with_name("shaders") / "matte.frag"
+SHADERS = Path(__file__).with_name("shaders")
+MATTE_SHADER = SHADERS / "matte.frag"
+LABELS_VERT, LABELS_FRAG = SHADERS / "labels.vert", SHADERS / "labels.frag"
+WHITE = np.array([255, 255, 255])  # segmentation colour: labels.frag outputs labels as they are
 SHADINGS = ("matte", "pbr")
 
 
@@ -153,13 +159,76 @@ def pinhole_K(fov_x_rad: float, width: int, height: int) -> np.ndarray:
     return np.array([[f, 0.0, 0.5 * (width - 1)], [0.0, f, 0.5 * (height - 1)], [0, 0, 1.0]])
 
 
-class _MatteProgramCache(ShaderProgramCache):
-    """pyrender's shader cache with the colour fragment shader swapped for the matte one."""
+class _BodyProgramCache(ShaderProgramCache):
+    """pyrender's shader cache with BodyScene's shaders swapped in: the label pass always, the
+    matte colour shader when asked."""
+
+    def __init__(self, matte: bool):
+        super().__init__()
+        self._swaps = {"segmentation.vert": LABELS_VERT, "segmentation.frag": LABELS_FRAG}
+        if matte:
+            self._swaps["mesh.frag"] = MATTE_SHADER
 
     def get_program(self, vertex_shader, fragment_shader, geometry_shader=None, defines=None):
-        if fragment_shader == "mesh.frag":
-            fragment_shader = str(MATTE_SHADER)  # absolute: os.path.join keeps it as is
+        # Absolute paths: pyrender's os.path.join keeps them as they are.
+        vertex_shader = str(self._swaps.get(vertex_shader, vertex_shader))
+        fragment_shader = str(self._swaps.get(fragment_shader, fragment_shader))
         return super().get_program(vertex_shader, fragment_shader, geometry_shader, defines)
+
+
+class _BodyRenderer(pyrender.Renderer):
+    """pyrender's renderer with BodyScene's shaders, single-sampled unless ``antialias``.
+
+    pyrender always renders into a 4x multisampled framebuffer; giving its buffers one sample
+    makes every pass sample pixel centres (and is cheaper in software rendering).
+    """
+
+    def __init__(self, width: int, height: int, matte: bool, antialias: bool):
+        super().__init__(width, height)
+        self._program_cache = _BodyProgramCache(matte)
+        self.antialias = antialias
+
+    def _configure_main_framebuffer(self):
+        size = (self.viewport_width, self.viewport_height)
+        fresh = self._main_fb is None or self._main_fb_dims != size
+        super()._configure_main_framebuffer()
+        if fresh and not self.antialias:
+            layouts = ((self._main_cb_ms, GL.GL_RGBA), (self._main_db_ms, GL.GL_DEPTH_COMPONENT24))
+            for buffer, layout in layouts:
+                GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, buffer)
+                GL.glRenderbufferStorage(GL.GL_RENDERBUFFER, layout, *size)
+
+
+
+class _Contexts:
+    """Counts the live GL contexts of all scenes. With EGL, every context lives on one shared
+    display, and pyrender's ``OffscreenRenderer.delete`` terminates that display, killing the
+    other scenes' contexts (``EGL_BAD_DISPLAY``): while others live, only the closing scene's
+    context is destroyed."""
+
+    live = 0
+
+    @classmethod
+    def open(cls, width: int, height: int, matte: bool, antialias: bool):
+        offscreen = pyrender.OffscreenRenderer(width, height)
+        offscreen._renderer = _BodyRenderer(width, height, matte, antialias)  # no GL state yet
+        cls.live += 1
+        return offscreen
+
+    @classmethod
+    def close(cls, offscreen: pyrender.OffscreenRenderer) -> None:
+        cls.live -= 1
+        platform = offscreen._platform
+        if cls.live == 0 or getattr(platform, "_egl_display", None) is None:
+            offscreen.delete()  # the last one, or a platform without a shared display
+            return
+        from OpenGL.EGL import eglDestroyContext
+
+        platform.make_current()
+        offscreen._renderer.delete()
+        eglDestroyContext(platform._egl_display, platform._egl_context)
+        platform._egl_context = platform._egl_display = None
+        offscreen._renderer = offscreen._platform = None
 
 
 class BodyScene:
@@ -173,6 +242,8 @@ class BodyScene:
         background: RGB 0-255 of empty pixels.
         shading: ``"matte"`` (diffuse only, ~2x faster in software rendering) or ``"pbr"``
             (pyrender's physically based shader, with a weak specular highlight).
+        antialias: 4x multisampled colour (smoother edges; depth then comes from one sample,
+            ~0.37 px off the pixel centre). Off: exact pixel-centre sampling, faster.
     """
 
     def __init__(
@@ -183,10 +254,12 @@ class BodyScene:
         room: Room | None = None,
         background: tuple[int, int, int] = (150, 160, 175),
         shading: str = "matte",
+        antialias: bool = False,
     ):
         if shading not in SHADINGS:
             raise SceneError(f"shading must be one of {SHADINGS}, got {shading!r}")
         self.shading = shading
+        self.antialias = antialias
         self.body = body if isinstance(body, BodyDescription) else build_body(body)
         self.clothing = clothing or Clothing()
         self.scene = pyrender.Scene(
@@ -195,10 +268,7 @@ class BodyScene:
         segments = self.body.segments
         self.part_names: tuple[str, ...] = tuple(s.name for s in segments)
         self.part_bodies = np.array([s.body for s in segments])
-        pieces = [self._segment_mesh(s) for s in segments]
-        self._part_nodes = [self._add_segment(s, p) for s, p in zip(segments, pieces, strict=True)]
-        self._init_merged_body(pieces)
-        self._seg_map = {node: self._label_colour(k + 1) for k, node in enumerate(self._part_nodes)}
+        self._init_merged_body([self._segment_mesh(s) for s in segments])
         if floor:
             self._add_floor()
         if room is not None:
@@ -215,16 +285,9 @@ class BodyScene:
         template = mesh_template((segment,))
         return trimesh.Trimesh(template.vertices, template.faces, process=False)
 
-    def _add_segment(self, segment, mesh: trimesh.Trimesh) -> pyrender.Node:
-        material = pyrender.MetallicRoughnessMaterial(
-            baseColorFactor=np.r_[self.clothing.colour_of(segment.kind), 1.0],
-            metallicFactor=0.0,
-            roughnessFactor=0.8,
-        )
-        return self.scene.add(pyrender.Mesh.from_trimesh(mesh, material=material, smooth=True))
-
     def _init_merged_body(self, pieces: list[trimesh.Trimesh]) -> None:
-        """The merged body: segment meshes (body frames) concatenated, coloured per vertex."""
+        """The merged body: segment meshes (body frames) concatenated, coloured and labelled
+        per vertex."""
         sizes = [len(p.vertices) for p in pieces]
         merged = trimesh.util.concatenate(pieces)
         self._merged_vertices = np.asarray(merged.vertices)  # (V, 3) body frames
@@ -233,11 +296,12 @@ class BodyScene:
         self._merged_vertex_body = np.repeat(self.part_bodies, sizes)  # (V,)
         colours = np.stack([self.clothing.colour_of(s.kind) for s in self.body.segments])
         self._merged_colours = np.c_[np.repeat(colours, sizes, axis=0), np.ones(sum(sizes))]
+        labels = np.repeat(np.arange(1, len(pieces) + 1), sizes)
+        self._merged_labels = np.c_[labels, np.zeros(len(labels))]  # (V, 2) texcoord_1
         self._merged_material = pyrender.MetallicRoughnessMaterial(
             baseColorFactor=[1.0, 1.0, 1.0, 1.0], metallicFactor=0.0, roughnessFactor=0.8
         )
         self._merged_node: pyrender.Node | None = None
-        self._merged_pose: tuple[np.ndarray, np.ndarray] | None = None
 
     def _add_floor(self) -> None:
         half = 10.0
@@ -247,11 +311,6 @@ class BodyScene:
             baseColorFactor=[0.55, 0.52, 0.48, 1.0], metallicFactor=0.0, roughnessFactor=1.0
         )
         self.scene.add(pyrender.Mesh.from_trimesh(floor, material=material, smooth=False))
-
-    @staticmethod
-    def _label_colour(label: int) -> np.ndarray:
-        # Labels are written into the red and green channels of the flat segmentation pass.
-        return np.array([label % 256, label // 256, 0], dtype=np.uint8)
 
     # -- pose ---------------------------------------------------------------------------
     def set_pose(self, positions: np.ndarray, rotations: np.ndarray) -> None:
@@ -267,50 +326,22 @@ class BodyScene:
                 f"pose must be ({n}, 3) positions and ({n}, 3, 3) rotations, "
                 f"got {positions.shape} and {rotations.shape}"
             )
-        poses = np.tile(np.eye(4), (len(self._part_nodes), 1, 1))
-        poses[:, :3, :3] = rotations[self.part_bodies]
-        poses[:, :3, 3] = positions[self.part_bodies]
-        for node, pose in zip(self._part_nodes, poses, strict=True):
-            self.scene.set_pose(node, pose)
-        self._merged_pose = (positions, rotations)
-        if self._merged_node is not None:  # stale: rebuilt by the next colour render
+        body = self._merged_vertex_body
+        # v_world = R_body v + p_body, n_world = R_body n, for all vertices at once.
+        vertices = np.einsum("vij,vj->vi", rotations[body], self._merged_vertices)
+        normals = np.einsum("vij,vj->vi", rotations[body], self._merged_normals)
+        primitive = pyrender.Primitive(
+            positions=vertices + positions[body],
+            normals=normals,
+            color_0=self._merged_colours,
+            texcoord_1=self._merged_labels,
+            indices=self._merged_faces,
+            material=self._merged_material,
+        )
+        # A new Mesh each pose: pyrender uploads vertices when a mesh enters the scene.
+        if self._merged_node is not None:
             self.scene.remove_node(self._merged_node)
-            self._merged_node = None
-
-    def _merged_body_node(self) -> pyrender.Node:
-        """The merged body node at the current pose (built once per pose)."""
-        if self._merged_node is None:
-            if self._merged_pose is None:
-                raise SceneError("pose the body (update or set_pose) before rendering it")
-            positions, rotations = self._merged_pose
-            body = self._merged_vertex_body
-            # v_world = R_body v + p_body, n_world = R_body n, for all vertices at once.
-            vertices = np.einsum("vij,vj->vi", rotations[body], self._merged_vertices)
-            normals = np.einsum("vij,vj->vi", rotations[body], self._merged_normals)
-            primitive = pyrender.Primitive(
-                positions=vertices + positions[body],
-                normals=normals,
-                color_0=self._merged_colours,
-                indices=self._merged_faces,
-                material=self._merged_material,
-            )
-            # A new Mesh each pose: pyrender uploads vertices when a mesh enters the scene.
-            self._merged_node = self.scene.add(pyrender.Mesh([primitive]))
-        return self._merged_node
-
-    @contextmanager
-    def _merged_body_drawn(self):
-        """Within: the merged body is drawn instead of the per-segment nodes."""
-        merged = self._merged_body_node()
-        merged.mesh.is_visible = True
-        for node in self._part_nodes:
-            node.mesh.is_visible = False
-        try:
-            yield
-        finally:
-            for node in self._part_nodes:
-                node.mesh.is_visible = True
-            merged.mesh.is_visible = False
+        self._merged_node = self.scene.add(pyrender.Mesh([primitive]))
 
     def update(self, motion: Motion, frame: int) -> None:
         """Pose the body as frame ``frame`` of ``motion`` (on the body's skeleton)."""
@@ -320,64 +351,59 @@ class BodyScene:
         self.set_pose(positions[0], rotations[0])
 
     # -- rendering ----------------------------------------------------------------------
-    def _renderer_of_size(self, width: int, height: int) -> pyrender.OffscreenRenderer:
-        # One renderer (one GL context) per scene: pyrender binds meshes to a single context.
-        # A new size only resizes its framebuffer, which cube-map faces never do.
-        if self._renderer is None:
-            self._renderer = pyrender.OffscreenRenderer(width, height)
-            if self.shading == "matte":
-                # Private in pyrender, but the documented way to bring one's own shaders.
-                self._renderer._renderer._program_cache = _MatteProgramCache()
-        self._renderer.viewport_width, self._renderer.viewport_height = width, height
-        return self._renderer
-
-    def _place_camera(self, camera_to_world: np.ndarray, K: np.ndarray) -> None:
+    def _prepare(
+        self, camera_to_world: np.ndarray, K: np.ndarray, width: int, height: int
+    ) -> pyrender.OffscreenRenderer:
+        """This scene's renderer, sized, with the camera placed (checks every argument)."""
+        K, width, height = check_intrinsics(K, width, height)
         pose = np.asarray(camera_to_world, float)
         if pose.shape != (4, 4) or not np.all(np.isfinite(pose)):
             raise SceneError(f"camera pose must be a finite 4x4 matrix, got {pose.shape}")
+        if self._merged_node is None:
+            raise SceneError("pose the body (update or set_pose) before rendering it")
         self._camera.fx, self._camera.fy = K[0, 0], K[1, 1]
         # pyrender puts pixel centres at half-integers; OpenCV at integers.
         self._camera.cx, self._camera.cy = K[0, 2] + 0.5, K[1, 2] + 0.5
         self.scene.set_pose(self._camera_node, pose @ CV_TO_GL)
+        # One renderer (one GL context) per scene: pyrender binds meshes to a single context.
+        # A new size only resizes its framebuffer.
+        if self._renderer is None:
+            self._renderer = _Contexts.open(width, height, self.shading == "matte", self.antialias)
+        self._renderer.viewport_width, self._renderer.viewport_height = width, height
+        return self._renderer
 
     def render(
         self, camera_to_world: np.ndarray, K: np.ndarray, width: int, height: int
     ) -> tuple[np.ndarray, np.ndarray]:
         """Colour ``(H, W, 3)`` uint8 and depth ``(H, W)`` float32 metres (camera z; 0 = no hit)
         of a pinhole camera with intrinsics ``K`` at pose ``camera_to_world`` (OpenCV axes)."""
-        K, width, height = check_intrinsics(K, width, height)
-        self._place_camera(camera_to_world, K)
-        renderer = self._renderer_of_size(width, height)
-        with self._merged_body_drawn():
-            color, depth = renderer.render(self.scene)
-        return color, depth
+        return self._prepare(camera_to_world, K, width, height).render(self.scene)
+
+    def render_depth_and_parts(
+        self, camera_to_world: np.ndarray, K: np.ndarray, width: int, height: int
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Depth ``(H, W)`` float32 metres (camera z; 0 = no hit) and part labels ``(H, W)``
+        int32 (0 background, ``k + 1`` segment ``k``) from one pass: they agree at every
+        pixel, silhouettes included."""
+        renderer = self._prepare(camera_to_world, K, width, height)
+        # pyrender's SEG pass draws only the nodes in the map: all of them, so that depth
+        # covers the whole scene; meshes without per-vertex labels come out as 0.
+        every_mesh = dict.fromkeys(self.scene.mesh_nodes, WHITE)
+        seg, depth = renderer.render(self.scene, pyrender.RenderFlags.SEG, every_mesh)
+        labels = seg[..., 0].astype(np.int32)
+        labels += seg[..., 1].astype(np.int32) << 8
+        return depth, labels
 
     def render_parts(
         self, camera_to_world: np.ndarray, K: np.ndarray, width: int, height: int
     ) -> np.ndarray:
         """``(H, W)`` int32 body-part labels (0 background, ``k + 1`` segment ``k``)."""
-        K, width, height = check_intrinsics(K, width, height)
-        self._place_camera(camera_to_world, K)
-        flags = pyrender.RenderFlags.SEG
-        seg, depth = self._renderer_of_size(width, height).render(self.scene, flags, self._seg_map)
-        labels = seg[..., 0].astype(np.int32) + 256 * seg[..., 1].astype(np.int32)
-        # pyrender draws multisampled, so pixels on a label edge hold blended colours that
-        # may decode to a wrong label. Keep labels whose 3x3 neighbourhood agrees; an edge
-        # pixel takes a neighbouring trusted label when its depth is that of the body there
-        # (within 5 cm of the nearest trusted body pixel), else background.
-        kernel = np.ones((3, 3), np.uint8)
-        as_float = labels.astype(np.float32)
-        uniform = cv2.erode(as_float, kernel) == cv2.dilate(as_float, kernel)
-        trusted = np.where(uniform, labels, 0)
-        body_depth = np.where(trusted > 0, depth, np.inf).astype(np.float32)
-        on_body = (depth > 0) & (depth <= cv2.erode(body_depth, kernel) + 0.05)
-        edge_label = cv2.dilate(trusted.astype(np.float32), kernel).astype(np.int32)
-        return np.where(uniform, labels, np.where(on_body, edge_label, 0))
+        return self.render_depth_and_parts(camera_to_world, K, width, height)[1]
 
     def close(self) -> None:
-        """Release the OpenGL contexts."""
+        """Release this scene's OpenGL context (other scenes keep theirs)."""
         if self._renderer is not None:
-            self._renderer.delete()
+            _Contexts.close(self._renderer)
             self._renderer = None
 
     def __enter__(self) -> BodyScene:

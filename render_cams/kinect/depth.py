@@ -2,9 +2,9 @@
 
 A frame is what the SDKs hand out: depth as ``uint16`` millimetres (0 = no reading) and a
 body-index map as ``uint8`` (0 for the tracked body, 255 for no body, as Kinect V2's
-``BodyIndexFrame`` and Azure's ``k4abt`` body-index map). Both come from a segmentation pass
-of the scene (part labels) and a depth-only pass, then the depth noise model; lateral noise
-moves the body index with the depth so the two stay aligned.
+``BodyIndexFrame`` and Azure's ``k4abt`` body-index map). Both come from one segmentation
+pass of the scene (depth and part labels, agreeing at every pixel), then the depth noise
+model; lateral noise moves the body index with the depth so the two stay aligned.
 """
 
 from __future__ import annotations
@@ -14,7 +14,6 @@ from pathlib import Path
 
 import cv2
 import numpy as np
-import pyrender
 
 from render_cams.kinect.noise import DepthNoiseModel
 from render_cams.kinect.sensors import DepthSensor, KinectError, get_sensor
@@ -62,19 +61,10 @@ class KinectDepthCamera:
         self.noise = noise
 
     def render_clean(self, scene: BodyScene) -> tuple[np.ndarray, np.ndarray]:
-        """Noise-free ``(H, W)`` depth in metres (0 = no hit, no range limit) and ``(H, W)``
-        int32 part labels (0 background, > 0 body) of the scene as posed now."""
+        """Noise-free ``(H, W)`` float32 depth in metres (0 = no hit, no range limit) and
+        ``(H, W)`` int32 part labels (0 background, > 0 body) of the scene as posed now."""
         s = self.sensor
-        # Two passes through BodyScene's camera and renderer (BodyScene.render draws colour
-        # too, render_parts drops the depth): segmentation, which draws only the body and
-        # without multisampling, gives the labels and the body's depth under them; a
-        # depth-only pass gives the rest of the scene.
-        scene._place_camera(self.camera_to_world, s.K)
-        renderer = scene._renderer_of_size(s.width, s.height)
-        seg, body_depth = renderer.render(scene.scene, pyrender.RenderFlags.SEG, scene._seg_map)
-        parts = seg[..., 0].astype(np.int32) + 256 * seg[..., 1].astype(np.int32)
-        depth = renderer.render(scene.scene, pyrender.RenderFlags.DEPTH_ONLY)
-        return np.where(parts > 0, body_depth, depth).astype(float), parts
+        return scene.render_depth_and_parts(self.camera_to_world, s.K, s.width, s.height)
 
     def capture(self, scene: BodyScene, rng: np.random.Generator) -> DepthFrame:
         """The depth frame and body-index map the sensor records of ``scene`` as posed now."""
