@@ -1,0 +1,76 @@
+"""Rendered device views of the ground truth for the report: the four controller fisheye
+cameras (ControllerPose) and a Kinect depth frame, recorded over a short window mid-clip."""
+
+from __future__ import annotations
+
+import time
+
+import cv2
+import imageio.v3 as iio
+import numpy as np
+
+from render_cams.kinect.depth import colourise, read_depth_png
+from render_cams.kinect.sensors import get_sensor
+from scripts.results import write_atomic
+from scripts.run_context import RunContext
+
+METRICS = {
+    "fisheye_fps_rendered": "fisheye camera frames rendered per second (all cameras)",
+    "kinect_fps_rendered": "Kinect depth frames rendered per second",
+}
+WINDOW_S = 0.1  # a few frames at the cameras' 30 Hz, mid-clip
+PANEL_H = 240
+
+
+def window(ctx: RunContext):
+    middle = ctx.motion.n_frames // 2
+    return ctx.motion[middle : middle + max(2, int(round(WINDOW_S * ctx.motion.fps)))]
+
+
+def panel(image: np.ndarray, label: str) -> np.ndarray:
+    """``image`` scaled to the panel height with ``label`` on it (RGB uint8)."""
+    rgb = image if image.ndim == 3 else np.repeat(image[..., None], 3, axis=2)
+    rgb = np.ascontiguousarray(rgb[..., :3])
+    scaled = cv2.resize(
+        rgb, (int(rgb.shape[1] * PANEL_H / rgb.shape[0]), PANEL_H), interpolation=cv2.INTER_AREA
+    )
+    cv2.putText(
+        scaled, label, (6, 18), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (255, 255, 255), 1, cv2.LINE_AA
+    )
+    return scaled
+
+
+def run(ctx: RunContext) -> None:
+    spec = ctx.scenario.cameras
+    if spec is None:
+        return
+    clip = window(ctx)
+    panels = []
+    if spec.fisheye:
+        from render_cams.fisheye.sequence import render_fisheye_sequence
+
+        folder = ctx.out_dir / "cameras" / "fisheye"
+        summary = render_fisheye_sequence(clip, folder, seed=ctx.scenario.seed, video=False)
+        ctx.metrics["fisheye_fps_rendered"] = float(summary["fps_rendered"])
+        for cam in sorted(p for p in folder.iterdir() if p.is_dir()):
+            panels.append(panel(iio.imread(cam / "000000.png"), cam.name))
+        ctx.output("fisheye_keypoints", folder / "keypoints.json")
+    if spec.kinect:
+        from render_cams.kinect.sequence import render_kinect_sequence
+
+        folder = ctx.out_dir / "cameras" / spec.kinect
+        t0 = time.perf_counter()
+        summary = render_kinect_sequence(clip, folder, device=spec.kinect, seed=ctx.scenario.seed)
+        ctx.metrics["kinect_fps_rendered"] = summary["frames"] / (time.perf_counter() - t0)
+        depth = read_depth_png(sorted((folder / "depth").glob("*.png"))[0])
+        bgr = colourise(depth, get_sensor(spec.kinect).range_m)
+        panels.append(panel(bgr[..., ::-1], f"{spec.kinect} depth"))
+        ctx.output("kinect_recording", folder / "recording.json")
+    if panels:
+        strip = np.hstack(panels)
+        ctx.output(
+            "cameras_png",
+            write_atomic(
+                ctx.out_dir / "cameras.png", iio.imwrite("<bytes>", strip, extension=".png")
+            ),
+        )
