@@ -86,10 +86,10 @@ class TrackingSettings:
 
     kp: float = 400.0
     kd: float = 40.0
-    kp_root: float = 100.0
+    kp_root: float = 50.0
     kp_root_xy: float = 0.0
     kd_root: float = 20.0
-    root_weight: float = 10.0
+    root_weight: float = 3.0
     foot_weight: float = 30.0
     kp_foot: float = 400.0
     kd_foot: float = 40.0
