@@ -71,13 +71,16 @@ class KinectDepthCamera:
         depth, parts = self.render_clean(scene)
         near, far = self.sensor.range_m
         if self.noise is None:
-            measured = np.where((depth >= near) & (depth <= far), depth, 0.0)
+            measured = np.where((depth >= near) & (depth <= far), depth, np.float32(0.0))
             body = parts > 0
         else:
             measured, source = self.noise.apply(depth, self.sensor.K, (near, far), rng)
             body = parts.ravel()[source] > 0
-        body_index = np.where(body & (measured > 0), 0, BODY_INDEX_NONE).astype(np.uint8)
-        return DepthFrame(np.rint(measured * 1e3).astype(np.uint16), body_index)
+        body_index = np.full(measured.shape, BODY_INDEX_NONE, np.uint8)
+        body_index[body & (measured > 0)] = 0
+        measured *= 1e3  # to millimetres, rounded half up (depth is never negative)
+        measured += 0.5
+        return DepthFrame(measured.astype(np.uint16), body_index)
 
 
 def write_png(image: np.ndarray, path: str | Path) -> Path:

@@ -139,7 +139,7 @@ class DepthNoiseModel:
         h, w = depth.shape
         # theta / (pi/2 - theta) per pixel: both sigmas depend on theta only through it.
         ratio = self._angle_ratio(incidence_angles(depth, K))
-        jitter = rng.standard_normal((2, h, w), dtype=np.float32)
+        jitter = standard_normal(rng, (2, h, w))
         jitter *= self._lateral_sigma_of_ratio(ratio)
         jitter += _pixel_grid(h, w)  # (row, column) of the sampled position
         np.rint(jitter, out=jitter)
@@ -153,7 +153,7 @@ class DepthNoiseModel:
         valid = np.flatnonzero(z)  # sampled a surface
         z_valid = z.ravel()[valid]
         ratio_valid = ratio.ravel()[source.ravel()[valid]]
-        measured = rng.standard_normal(len(valid), dtype=np.float32)
+        measured = standard_normal(rng, len(valid))
         measured *= self._axial_sigma_of_ratio(z_valid, ratio_valid)
         measured += z_valid
         near, far = range_m
@@ -172,6 +172,28 @@ class DepthNoiseModel:
         flat = z.reshape(-1)
         near_side = flat[index]
         flat[index] = near_side + rng.random(len(index), dtype=np.float32) * (other - near_side)
+
+
+def standard_normal(rng: np.random.Generator, shape: int | tuple[int, ...]) -> np.ndarray:
+    """float32 standard normal samples of ``shape``, by the Box-Muller transform of float32
+    uniforms (pairs ``sqrt(-2 ln(1 - u1)) (cos, sin)(2 pi u2)``).
+
+    Why not ``rng.standard_normal(dtype=np.float32)``: here it is ~2.5x slower, and three
+    normals per pixel were a third of a Kinect frame. The uniforms' 24-bit resolution caps
+    ``|n|`` at 5.8 (a normal exceeds that with probability 7e-9).
+    """
+    n = int(np.prod(shape))
+    half = (n + 1) // 2
+    u = rng.random((2, half), dtype=np.float32)
+    radius = np.log1p(-u[0])
+    radius *= -2.0
+    np.sqrt(radius, out=radius)
+    angle = u[1]
+    angle *= np.float32(2.0 * np.pi)
+    out = np.empty(2 * half, np.float32)
+    np.multiply(radius, np.cos(angle), out=out[:half])
+    np.multiply(radius, np.sin(angle), out=out[half:])
+    return out[:n].reshape(shape)
 
 
 def _edge_partners(depth: np.ndarray, jump_m: float) -> tuple[np.ndarray, np.ndarray]:
