@@ -199,7 +199,6 @@ class _BodyRenderer(pyrender.Renderer):
                 GL.glRenderbufferStorage(GL.GL_RENDERBUFFER, layout, *size)
 
 
-
 class _Contexts:
     """Counts the live GL contexts of all scenes. With EGL, every context lives on one shared
     display, and pyrender's ``OffscreenRenderer.delete`` terminates that display, killing the

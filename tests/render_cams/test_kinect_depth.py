@@ -20,8 +20,7 @@ POSE = look_at([1.0, 0.0, 1.0], [0.0, 0.0, 1.0])  # 1 m in front of the user, 1 
 
 @pytest.fixture(scope="module")
 def user_scene():
-    """The T-pose user on the floor. One scene per module: closing a pyrender EGL renderer
-    invalidates the others, so the tests share this one."""
+    """The T-pose user on the floor, shared by the module's tests (one GL context)."""
     motion = t_pose(1)
     scene = BodyScene(motion.skeleton)
     scene.update(motion, 0)
@@ -77,7 +76,7 @@ def test_floor_depth_matches_ray_plane_intersections_and_range(user_scene):
     floor_depth, lower, upper = (
         _floor_depth(rays + [0.0, dv / K[1, 1], 0.0]) for dv in (0.0, -0.5, 0.5)
     )
-    # Silhouette edge pixels may mix body and floor (multisampled depth): left out.
+    # The floor next to the body: labels and depth agree, but keep off the silhouette.
     near_body = cv2.dilate((frame.body_index == 0).astype(np.uint8), np.ones((5, 5))) > 0
     floor = ~near_body & np.isfinite(floor_depth)
     in_range = floor & (upper <= 4.4) & np.isfinite(lower)
