@@ -29,7 +29,7 @@ import numpy as np
 
 from avatar_models import Motion
 from avatar_models.body import BodyError
-from avatar_models.generator import generate, sample_subject
+from avatar_models.generator import Subject, generate, sample_subject
 from avatar_models.library import MotionLibrary
 from avatar_models.measure import standing_height
 from avatar_models.rigs import load_rig
@@ -43,8 +43,16 @@ PROTOCOLS = ("cross-subject", "cross-trial")
 METHODS: dict[str, Options] = {
     "coolmoves": Options(),
     "coolmoves-gmm": Options(matcher="gmm"),
+    "coolmoves-centroid-align": Options(align_about_centroid=True),
 }
-"""Evaluable methods and their options (the GMM variant is the paper's slower alternative)."""
+"""Evaluable methods and their options (the GMM variant is the paper's slower alternative;
+``coolmoves-centroid-align`` aligns with the paper's printed equation, see
+:mod:`synthesis.coolmoves.alignment`)."""
+TAKE_VARIATION = 0.15
+"""Built-in takes: each take scales its subject's tempo and amplitude by a factor drawn
+uniformly in ``1 +- TAKE_VARIATION``, so that two takes of one subject differ in speed and
+range as repeated mocap trials do (else they differ only in start phase and seed, and
+cross-trial would find the test take's own poses in the database)."""
 ABLATION: dict[str, dict[str, bool]] = {
     "no_alignment_no_smoothing": {"align": False, "smooth": False},
     "alignment_no_smoothing": {"align": True, "smooth": False},
@@ -87,14 +95,28 @@ def builtin_trials(
     n_takes: int = 2,
     duration_s: float = 8.0,
     seed: int = 0,
+    take_variation: float = TAKE_VARIATION,
 ) -> list[Trial]:
-    """Generated trials: ``n_subjects`` sampled subjects x ``activities`` x ``n_takes``."""
+    """Generated trials: ``n_subjects`` sampled subjects x ``activities`` x ``n_takes``; each
+    take varies its subject's tempo and amplitude by ``1 +- take_variation``."""
     rng = np.random.default_rng(seed)
     subjects = [sample_subject(rng) for _ in range(n_subjects)]
     seeds = rng.integers(0, 2**31 - 1, size=(len(activities), n_subjects, n_takes))
+    factors = rng.uniform(1 - take_variation, 1 + take_variation, (*seeds.shape, 2))
+
+    def take_of(subject: Subject, f: np.ndarray) -> Subject:
+        tempo, amplitude = np.clip([subject.tempo * f[0], subject.amplitude * f[1]], 0.5, 1.5)
+        return replace(subject, tempo=float(tempo), amplitude=float(amplitude))
+
     return [
         Trial(
-            generate(activity, subject, duration_s, 90.0, int(seeds[a, s, k])),
+            generate(
+                activity,
+                take_of(subject, factors[a, s, k]),
+                duration_s,
+                90.0,
+                int(seeds[a, s, k]),
+            ),
             activity,
             str(s),
             k + 1,
@@ -225,27 +247,41 @@ def _score(synth: Synthesizer, truth: Motion, stream: TrackingStream) -> dict:
     }
 
 
+def turned(trial: Trial, heading_deg: float) -> Motion:
+    """The trial's motion turned about Z by a yaw drawn uniformly in ``+-heading_deg`` (from
+    the trial's seed): the user facing another way than the database's performers."""
+    if heading_deg == 0:
+        return trial.motion
+    yaw = np.random.default_rng([trial.seed, 2]).uniform(-1.0, 1.0) * np.radians(heading_deg)
+    return trial.motion.rotated_about_z(float(yaw))
+
+
 def evaluate_fold(
     fold: Fold,
     options: Options,
     setup: VRSetup,
     ablation: bool = True,
     baseline_cache: dict | None = None,
+    heading_deg: float = 0.0,
 ) -> list[dict]:
-    """Per test trial of ``fold``: the method, its ablation variants and the IK baseline."""
+    """Per test trial of ``fold``: the method, its ablation variants and the IK baseline.
+
+    ``heading_deg``: turn each test motion by a random yaw up to this (:func:`turned`).
+    """
     database = build_database([t.motion for t in fold.train])
     cache = {} if baseline_cache is None else baseline_cache
     rows = []
     for trial in fold.test:
-        stream = setup.sample(trial.motion, seed=trial.seed)
-        height = standing_height(trial.motion)
+        truth = turned(trial, heading_deg)
+        stream = setup.sample(truth, seed=trial.seed)
+        height = standing_height(truth)
         row = {"trial": trial.name, "cls": trial.cls, "held_out": fold.held_out}
-        row["method"] = _score(CoolMoves(database, height, options), trial.motion, stream)
+        row["method"] = _score(CoolMoves(database, height, options), truth, stream)
         if ablation:
             row["ablation"] = {
                 name: _score(
                     CoolMoves(database, height, replace(options, **switches)),
-                    trial.motion,
+                    truth,
                     stream,
                 )["err_cm"]["full"]
                 for name, switches in ABLATION.items()
@@ -254,9 +290,7 @@ def evaluate_fold(
             row["ablation"]["full"] = row["method"]["err_cm"]["full"]
         # The baseline does not use the database: one run per trial serves every fold.
         if trial.name not in cache:
-            cache[trial.name] = _score(
-                ik_baseline_for(database, trial.motion, setup), trial.motion, stream
-            )
+            cache[trial.name] = _score(ik_baseline_for(database, truth, setup), truth, stream)
         row["baseline"] = cache[trial.name]
         rows.append(row)
     return rows
@@ -311,6 +345,7 @@ def run_protocol(
     ablation: bool = True,
     setup: VRSetup | None = None,
     progress: Callable[[int, int, str], None] | None = None,
+    heading_deg: float = 0.0,
 ) -> dict:
     """Evaluate ``method`` on ``trials`` under ``protocol``.
 
@@ -318,7 +353,8 @@ def run_protocol(
     "failed_folds": [...], "folds": n, ...}``; a summary holds ``err_cm``, ``baseline_err_cm``
     (hands, upper, lower, full), ``hand_corr`` and ``baseline_hand_corr`` (left, right),
     ``frames_per_s`` and ``baseline_frames_per_s``, ``ablation_full_cm``, ``trials``.
-    ``progress(done, total, label)`` is called after every fold.
+    ``progress(done, total, label)`` is called after every fold. ``heading_deg`` turns each
+    test motion by a random yaw up to this (the database keeps its headings).
     """
     if method not in METHODS:
         raise EvaluationError(f"unknown method {method!r}; available: {', '.join(METHODS)}")
@@ -331,7 +367,7 @@ def run_protocol(
     rows, failed, cache = [], [], {}
     for i, fold in enumerate(all_folds):
         try:
-            rows.extend(evaluate_fold(fold, METHODS[method], setup, ablation, cache))
+            rows.extend(evaluate_fold(fold, METHODS[method], setup, ablation, cache, heading_deg))
         except SynthesisError as exc:  # e.g. every training clip fails the correlation filter
             failed.append({"class": fold.cls, "held_out": fold.held_out, "reason": str(exc)})
         if progress is not None:
@@ -350,5 +386,6 @@ def run_protocol(
         "skipped": skipped,
         "failed_folds": failed,
         "folds": len(all_folds),
+        "heading_deg": heading_deg,
         "paper": PAPER,
     }

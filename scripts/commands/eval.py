@@ -59,6 +59,9 @@ def register(app: typer.Typer) -> None:
         takes: Annotated[int, typer.Option(help="builtin: takes per subject and activity.")] = 2,
         duration: Annotated[float, typer.Option(help="builtin: seconds per take.")] = 8.0,
         ablation: Annotated[bool, typer.Option(help="Also run the ablation variants.")] = True,
+        heading: Annotated[
+            float, typer.Option(help="Turn each test motion by a random yaw up to this (deg).")
+        ] = 0.0,
         quick: Annotated[bool, typer.Option(help="Small inputs, for a smoke run.")] = False,
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
@@ -99,7 +102,9 @@ def register(app: typer.Typer) -> None:
             def progress(done: int, total: int, label: str) -> None:
                 bar.update(task, completed=done, total=total, description=label)
 
-            results = run_protocol(trials, protocol, method, ablation, progress=progress)
+            results = run_protocol(
+                trials, protocol, method, ablation, progress=progress, heading_deg=heading
+            )
         results.update(
             library=library, seed=seed, quick=quick, class_by=class_by, trials_total=len(trials)
         )

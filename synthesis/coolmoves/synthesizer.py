@@ -57,7 +57,10 @@ class Options:
 
     Attributes:
         k: matches per hand. max_distance: KD-tree neighbourhood threshold.
-        align: rotation alignment (§3.1.4). smooth: EWMA smoothing. clamp: joint limits.
+        align: rotation alignment (§3.1.4). align_about_centroid: the paper's printed
+            alignment equation (clouds turned about their centroids) instead of about the
+            head (:mod:`.alignment` says why the head is the default).
+        smooth: EWMA smoothing. clamp: joint limits.
         matcher: ``"knn"`` (the paper's method) or ``"gmm"`` (the slower mixture variant).
         arm_ik: beyond the paper, the share (0..1) by which each arm is bent with two-bone IK
             (:mod:`.two_bone`) so that its controller point reaches the tracked controller;
@@ -69,6 +72,7 @@ class Options:
     k: int = K_NEIGHBOURS
     max_distance: float = MAX_DISTANCE
     align: bool = True
+    align_about_centroid: bool = False
     smooth: bool = True
     clamp: bool = True
     matcher: str = "knn"
@@ -259,7 +263,7 @@ class CoolMoves(Synthesizer):
         safe = np.maximum(entries, 0)
         rotations = db.poses[db.entry_pose[safe]]  # (B, 2k, J, 4)
         if opts.align:
-            yaw = alignment_yaw(windows, db.windows[safe], tracked)
+            yaw = alignment_yaw(windows, db.windows[safe], tracked, opts.align_about_centroid)
             rotations = rotations.copy()
             rotations[:, :, 0] = quat.mul(quat.from_axis_angle(_Z, yaw), rotations[:, :, 0])
         joint_weights = weights[:, self._groups, :]  # (B, J, 2k)

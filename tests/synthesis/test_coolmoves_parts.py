@@ -115,8 +115,23 @@ def test_alignment_recovers_known_yaw(theta):
     # The database copy is the query turned by -theta and shifted sideways: turning it back by
     # +theta aligns it (the 1/sum c terms make the answer independent of the shift).
     source = query @ yaw_matrix(-theta).T + np.array([0.2, -0.1, 0.05])
-    got = alignment_yaw(query, source[:, None])
+    got = alignment_yaw(query, source[:, None], free_translation=True)
     assert got[0, 0] == pytest.approx(theta, abs=1e-9)
+    # About the head (the default) a copy turned about the head is undone exactly.
+    about_head = alignment_yaw(query, (query @ yaw_matrix(-theta).T)[:, None])
+    assert about_head[0, 0] == pytest.approx(theta, abs=1e-9)
+
+
+def test_alignment_about_head_keeps_forward_reach():
+    """Two hands held forward of the head, the right one punching further: the centred cloud
+    (paper's printed form) is turned to fit the hand-to-hand vector, the head pivot keeps the
+    forward reach and finds a far smaller yaw."""
+    t = np.linspace(0.0, 1.0, 9)[:, None]
+    query = np.stack([[0.35, 0.2, -0.3] + 0 * t, [0.35, -0.2, -0.3] + t * [0.25, 0, 0]], 1)
+    source = np.stack([[0.35, 0.2, -0.3] + 0 * t, [0.35, -0.2, -0.3] + 0 * t], 1)
+    about_centroid = alignment_yaw(query[None], source[None, None], free_translation=True)
+    about_head = alignment_yaw(query[None], source[None, None])
+    assert abs(about_centroid[0, 0]) > 3 * abs(about_head[0, 0])
 
 
 def test_alignment_weights_favour_the_newest_samples():

@@ -131,3 +131,30 @@ def test_style_sub_library(train_motions):
     assert len(happy) < len(train_motions)
     with pytest.raises(SynthesisError):
         style_sub_library(train_motions, "drunk")
+
+
+def test_alignment_undoes_a_turned_database(test_motion, stream):
+    """The database is the test motion itself turned by 40 deg: without alignment every
+    match faces the wrong way; alignment turns them back (the KD-tree still searches in world
+    axes, as the paper's unnormalised features do, so not every match is the right one)."""
+    database = build_database([test_motion.rotated_about_z(np.radians(40.0))])
+    height = standing_height(test_motion)
+
+    def full_error(**switches):
+        opts = Options(smooth=False, arm_ik=0.0, **switches)
+        return body17_errors_cm(CoolMoves(database, height, opts).run(stream), test_motion)["full"]
+
+    assert full_error(align=True) < 0.85 * full_error(align=False)
+
+
+def test_alignment_helps_a_user_facing_another_way(small_db, test_motion):
+    """Cross-subject with heading variation: the held-out user turned by 50 deg."""
+    truth = test_motion.rotated_about_z(np.radians(50.0))
+    turned_stream = VRSetup().sample(truth, seed=0)
+    height = standing_height(truth)
+
+    def full_error(align):
+        opts = Options(align=align, smooth=False)
+        return body17_errors_cm(CoolMoves(small_db, height, opts).run(turned_stream), truth)["full"]
+
+    assert full_error(True) < full_error(False) - 2.0
