@@ -72,7 +72,11 @@ class TrackingSettings:
         friction: cone coefficient of the QP, below the geoms' 1.0 for a margin.
         contact_margin: a foot within this of the floor (m) offers contacts to the QP.
         level_stance_feet: aim a foot the reference stands on flat (see ``_foot_tasks``).
-        step_position_gain, step_velocity_gain: SIMBICON ``c_d`` (m/m), ``c_v`` (s).
+        step_position_gain, step_velocity_gain: SIMBICON ``c_d`` (m/m), ``c_v`` (s), along the
+            reference's heading and sideways. No forward position gain: the stance leg
+            carries the body by the reference's joint angles, so a foot placed ahead of a
+            body that is ahead makes it further ahead (positive feedback); forward errors
+            are left to the velocity term.
         max_step_shift: bound on the foot-placement shift (m).
         swing_ramp_s: the shift fades in over this time after lift-off.
         stance_height: a reference foot stands while its ankle is within this of its lowest
@@ -99,8 +103,8 @@ class TrackingSettings:
     friction: float = 0.8
     contact_margin: float = 0.005
     level_stance_feet: bool = False
-    step_position_gain: float = 0.5
-    step_velocity_gain: float = 0.2
+    step_position_gain: tuple[float, float] = (0.0, 0.5)
+    step_velocity_gain: tuple[float, float] = (0.2, 0.2)
     max_step_shift: float = 0.25
     swing_ramp_s: float = 0.15
     stance_height: float = 0.03
@@ -240,8 +244,6 @@ class Tracker:
         model.actuator_gainprm[:, 0] = 1.0
         model.actuator_biasprm[:] = 0.0
         model.actuator_ctrllimited[:] = 0
-        model.geom_margin[:] = s.contact_margin
-        model.geom_gap[:] = s.contact_margin
         self.data = mujoco.MjData(model)
         self.dof = model.jnt_dofadr[model.actuator_trnid[:, 0]]
         self.sites = np.array(
@@ -254,7 +256,18 @@ class Tracker:
         hips = [np.flatnonzero(model.jnt_bodyid == model.body(name).id) for name in THIGHS]
         self.hip_dof = [model.jnt_dofadr[j] for j in hips]
         self.hip_qadr = [model.jnt_qposadr[j] for j in hips]
-        self.floor = [g for g in range(model.ngeom) if model.geom_bodyid[g] == 0]
+        # Sole boxes: the box geoms of the feet and the bodies below them (toes), with their
+        # 8 corners in the geom frame (the lowest ones are the sole's).
+        below_feet = np.isin(np.arange(model.nbody), self.feet)
+        for b in range(1, model.nbody):  # parents come before children in MuJoCo's order
+            below_feet[b] |= below_feet[model.body_parentid[b]]
+        self.sole_geoms = np.flatnonzero(
+            below_feet[model.geom_bodyid] & (model.geom_type == mujoco.mjtGeom.mjGEOM_BOX)
+        )
+        if self.sole_geoms.size == 0:
+            raise MotionValueError("tracking needs box feet (the sole corners are contacts)")
+        signs = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T
+        self.sole_corners = signs[None] * model.geom_size[self.sole_geoms][:, None]  # (G, 8, 3)
         nv = model.nv
         self.kp = np.full(nv, s.kp)
         self.kd = np.full(nv, s.kd)
@@ -266,8 +279,8 @@ class Tracker:
         mujoco.mj_kinematics(model, rest)  # qpos0 stands flat-footed on the floor
         self.sole_normal = [rest.xmat[b].reshape(3, 3)[2] for b in self.feet]  # R^T z
         mu = s.friction
-        # Friction-pyramid edges in the contact frame (normal, tangent 1, tangent 2).
-        self.edges = np.array([[1, mu, 0], [1, -mu, 0], [1, 0, mu], [1, 0, -mu]], float).T
+        # Friction-pyramid edges on the floor, world axes (x, y, z) by edge.
+        self.edges = np.array([[mu, 0, 1], [-mu, 0, 1], [0, mu, 1], [0, -mu, 1]], float).T
 
     def swing_weights(self, qpos: np.ndarray, fps: float) -> np.ndarray:
         """``(T, 2)`` 0..1 weight of the foot-placement shift per leg (left, right): 0 while
@@ -360,9 +373,12 @@ class Tracker:
     def _place_feet(self, q_target: np.ndarray, v_target: np.ndarray, swing: np.ndarray):
         """Shift the swinging hips' targets in ``q_target`` (in place); module docstring."""
         s, d = self.settings, self.data
-        shift = s.step_position_gain * (d.qpos[:2] - q_target[:2]) + s.step_velocity_gain * (
-            d.qvel[:2] - v_target[:2]
-        )
+        yaw = _yaw(q_target[3:7])
+        heading = np.array([[np.cos(yaw), np.sin(yaw)], [-np.sin(yaw), np.cos(yaw)]])
+        error = heading @ (d.qpos[:2] - q_target[:2])  # (forward, left)
+        rate = heading @ (d.qvel[:2] - v_target[:2])
+        gains = np.asarray(s.step_position_gain), np.asarray(s.step_velocity_gain)
+        shift = heading.T @ (gains[0] * error + gains[1] * rate)
         norm = np.linalg.norm(shift)
         if norm > s.max_step_shift:
             shift *= s.max_step_shift / norm
@@ -406,24 +422,26 @@ class Tracker:
         return generalised[self.dof]
 
     def _contacts(self) -> tuple[np.ndarray, np.ndarray]:
-        """``(3C, nv)`` Jacobian of the floor contact points and ``(nv, 4C)`` generalised
-        forces of their friction-pyramid edges."""
+        """``(3C, nv)`` Jacobian of the candidate floor contacts and ``(nv, 4C)`` generalised
+        forces of their friction-pyramid edges (world frame: the floor's normal is +Z).
+
+        The candidates are the corners of the sole boxes that are within
+        :attr:`TrackingSettings.contact_margin` of the floor, not MuJoCo's reported contacts:
+        on one foot MuJoCo often reports 1-3 points, which leaves the QP a support polygon
+        too small to push the body sideways; the corners span the whole sole."""
         m, d = self.model, self.data
-        pairs = [
-            (c, c.geom2 if c.geom1 in self.floor else c.geom1)
-            for c in d.contact[: d.ncon]
-            if (c.geom1 in self.floor) != (c.geom2 in self.floor)
-        ]
-        jc = np.zeros((3 * len(pairs), m.nv))
-        je = np.zeros((m.nv, 4 * len(pairs)))
-        for n, (c, geom) in enumerate(pairs):
-            jac = jc[3 * n : 3 * n + 3]
-            mujoco.mj_jac(m, d, jac, None, c.pos, m.geom_bodyid[geom])
-            frame = c.frame.reshape(3, 3)  # rows: normal (from geom1 to geom2), tangents
-            if c.geom2 in self.floor:
-                frame = -frame
-            je[:, 4 * n : 4 * n + 4] = jac.T @ (frame.T @ self.edges)
-        return jc, je
+        centre = d.geom_xpos[self.sole_geoms]  # (G, 3)
+        axes = d.geom_xmat[self.sole_geoms].reshape(-1, 3, 3)
+        corners = centre[:, None] + np.einsum("gij,gkj->gki", axes, self.sole_corners)
+        touching = np.isin(self.sole_geoms, d.contact.geom[: d.ncon])  # MuJoCo's contacts
+        near = (corners[..., 2] < self.settings.contact_margin) & touching[:, None]  # (G, 8)
+        geom, corner = np.nonzero(near)
+        points = corners[geom, corner]
+        jc = np.empty((3 * points.shape[0], m.nv))
+        for n, (point, g) in enumerate(zip(points, self.sole_geoms[geom], strict=True)):
+            mujoco.mj_jac(m, d, jc[3 * n : 3 * n + 3], None, point, m.geom_bodyid[g])
+        je = np.einsum("cin,ie->nce", jc.reshape(-1, 3, m.nv), self.edges)
+        return jc, je.reshape(m.nv, -1)
 
     def _foot_tasks(self, q_target, v_target, standing):
         """Per foot: ``(3, nv)`` rotational Jacobian and the desired angular acceleration
