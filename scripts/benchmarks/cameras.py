@@ -22,8 +22,10 @@ from scripts.benchmarks import BenchRow, best_of
 SENSOR_FPS = 30.0
 
 
-def _render_rate(motion, poses, model, face_size, shading: str, frames: int) -> float:
-    with BodyScene(motion.skeleton, shading=shading) as scene:
+def _render_rate(
+    motion, poses, model, face_size, shading: str, antialias: bool, frames: int
+) -> float:
+    with BodyScene(motion.skeleton, shading=shading, antialias=antialias) as scene:
         renderer = FisheyeRenderer(scene, model, face_size)
 
         def render_all():
@@ -35,11 +37,13 @@ def _render_rate(motion, poses, model, face_size, shading: str, frames: int) -> 
         return frames / best_of(render_all, repeat=2)
 
 
-# (face_size, shading, label): the default path, and the pre-optimisation one (five full
-# 90 deg faces at the fisheye's centre resolution, pyrender's PBR shader) for comparison.
+# (face_size, shading, antialias, label): the default path, the same with pyrender's 4x
+# multisampling, and the first version (five full 90 deg faces at the fisheye's centre
+# resolution, PBR shader, multisampled) for comparison.
 RENDER_CONFIGS = (
-    (None, "matte", "cropped resolution-matched faces, matte"),
-    (496, "pbr", "five full 496 px faces, PBR (previous default)"),
+    (None, "matte", False, "cropped resolution-matched faces, matte, single-sampled"),
+    (None, "matte", True, "cropped resolution-matched faces, matte, 4x multisampled"),
+    (496, "pbr", True, "five full 496 px faces, PBR, 4x multisampled (first version)"),
 )
 
 
@@ -50,8 +54,8 @@ def run(quick: bool = False) -> list[BenchRow]:
     model = FisheyeModel.from_fov()
     frames = 5 if quick else 20
     rows = []
-    for face_size, shading, label in RENDER_CONFIGS:
-        rate = _render_rate(motion, poses, model, face_size, shading, frames)
+    for face_size, shading, antialias, label in RENDER_CONFIGS:
+        rate = _render_rate(motion, poses, model, face_size, shading, antialias, frames)
         rows.append(
             BenchRow(
                 f"fisheye render 640x480 ({label})", "frames/s", rate, SENSOR_FPS, "sensor 30 fps"
