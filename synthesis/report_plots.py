@@ -35,6 +35,8 @@ def write_plots(results: dict, out: Path) -> dict[str, str]:
     into ``out``; returns ``{plot: path}``."""
     out.mkdir(parents=True, exist_ok=True)
     title = f"{results['method']} {results['protocol']}"
+    if results.get("heading_deg"):
+        title += f", test turned up to {results['heading_deg']:g} deg"
     overall, per_class = results["overall"], results["per_activity"]
     written = {}
 

@@ -19,7 +19,10 @@ from scripts.cli_common import JsonOpt, SeedOpt, console, emit_json, err_console
 
 
 def _table(results: dict) -> Table:
-    table = Table(title=f"{results['method']} {results['protocol']} (cm; IK baseline in brackets)")
+    turned = f", test turned up to {results['heading_deg']:g} deg" if results["heading_deg"] else ""
+    table = Table(
+        title=f"{results['method']} {results['protocol']}{turned} (cm; IK baseline in brackets)"
+    )
     for col in ("class", "trials", "hands", "upper", "lower", "full", "corr L/R", "frames/s"):
         table.add_column(col, justify="left" if col == "class" else "right")
     rows = {**results["per_activity"], "overall": results["overall"]}

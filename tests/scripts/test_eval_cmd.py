@@ -18,10 +18,11 @@ def test_eval_builtin_writes_contract_json_and_plots(tmp_path):
     result = runner.invoke(
         app,
         ["eval", "coolmoves", "--library", "builtin", "--classes", "box", *SMALL,
-         "--out", str(out), "--json", str(js)],
+         "--heading", "30", "--out", str(out), "--json", str(js)],
     )  # fmt: skip
     assert result.exit_code == 0, result.output
     payload = json.loads(js.read_text())
+    assert payload["heading_deg"] == 30.0 and "turned up to 30 deg" in result.output
     for summary in (payload["overall"], payload["per_activity"]["box"]):
         assert {"err_cm", "baseline_err_cm", "hand_corr", "frames_per_s"} <= set(summary)
         assert set(summary["err_cm"]) == {"hands", "upper", "lower", "full"}
