@@ -15,14 +15,29 @@ origin by the ratio of both skeletons' standing heights
 IK (:class:`avatar_models.body.ik.HumanoidIK`) steers the 17 body17 sites, with joint limits
 from the model and a weak pull towards the rest pose; the residual per frame is the mean
 site-to-target distance.
+
+Stance feet (:func:`level_stance_feet`): body17 has no foot orientation, so the first IK pass
+leaves a standing foot at whatever pitch joins its ankle and toe targets, often on its toes
+(Bandai: heel box ~2 cm up, toe box ~1 cm into the floor), which a physics tracker cannot stand
+on. The whole motion is first moved down by :func:`sole_offset` (the source's standing ankles sit
+higher than the humanoid's, e.g. on a shoe sole); the residual is measured against these
+shifted targets. A second pass then adds, on the frames a foot stands, a flat orientation
+target for the foot and toe bodies (the first pass's heading, no pitch or roll) and sets
+ankle and toe sites at their heights in the rest pose, which stands flat-footed on the floor;
+on the other frames no foot site goes below that height (toes dug into the floor at toe-off
+would throw the simulated body up). UHC and PhysDiff clean contact the same way: feet in
+stance are put on the ground before physics.
 """
 
 from __future__ import annotations
 
 from typing import NamedTuple
 
+import mujoco
 import numpy as np
+from scipy.spatial.transform import Rotation
 
+from avatar_models import quat
 from avatar_models.body import BodyDescription, build_body
 from avatar_models.body.ik import HumanoidIK, IKSettings, humanoid_model, motion_from_qpos
 from avatar_models.body17 import BODY17, INDEX
@@ -32,6 +47,14 @@ from avatar_models.motion import Motion
 from avatar_models.rigs import body17_positions, load_rig
 
 TEMPLATE_RIG = "avatar"
+FOOT_SITES = (("l_ankle", "l_foot"), ("r_ankle", "r_foot"))
+"""Per side, the body17 sites on the foot body and on the toe body."""
+STANCE_HEIGHT_M = 0.03
+"""A foot stands while its toe site is within this of its lowest height in the clip..."""
+STANCE_SPEED_M_S = 0.5
+"""...and its ankle moves slower than this horizontally (heel strike to toe-off)."""
+FOOT_ORIENTATION_COST = 1.0
+"""Weight of a stance foot's flat orientation (per rad²) next to the positions' 1 (per m²)."""
 SEGMENT_SPANS: dict[str, tuple[tuple[str, str], ...]] = {
     "thigh": (("l_hip", "l_knee"), ("r_hip", "r_knee")),
     "shank": (("l_knee", "l_ankle"), ("r_knee", "r_ankle")),
@@ -117,10 +140,15 @@ def fitted_body(motion: Motion, mass_kg: float = 75.0) -> BodyDescription:
 
 
 def retarget(
-    motion: Motion, body: BodyDescription | None = None, settings: IKSettings | None = None
+    motion: Motion,
+    body: BodyDescription | None = None,
+    settings: IKSettings | None = None,
+    level_feet: bool | None = None,
 ) -> Retargeted:
     """Retarget ``motion`` (any rig with a body17 map) onto ``body`` (default:
-    :func:`fitted_body`). Joint limits of the body hold in the result.
+    :func:`fitted_body`). Joint limits of the body hold in the result. ``level_feet``
+    (default: when the body is fitted, i.e. a foreign rig) puts stance feet flat on the floor
+    (module docstring); without it the body17 positions are matched as they are.
 
     Raises:
         MotionValueError: the motion's rig has no body17 map.
@@ -129,12 +157,80 @@ def retarget(
         targets = body17_positions(motion)
     except RigError as exc:
         raise MotionValueError(f"cannot retarget: {exc}") from exc
-    if body is None:
+    fitted = body is None
+    if fitted:
         body = fitted_body(motion)
     else:
         targets = targets * (standing_height(body.skeleton) / standing_height(motion))
-    ik = HumanoidIK(humanoid_model(body), BODY17, settings=settings)
-    result = ik.solve(targets)
-    out = motion_from_qpos(body, result.qpos, motion.fps)
+    model = humanoid_model(body)
+    if level_feet is None:
+        level_feet = fitted
+    ik = HumanoidIK(model, BODY17, settings=settings)
+    solved = ik.solve(targets)
+    qpos, residual_cm = solved.qpos, solved.residual_cm
+    if level_feet:
+        stance = stance_feet(targets, motion.fps)
+        offset = sole_offset(model, targets, stance)
+        qpos[:, 2] -= offset
+        targets = targets - [0.0, 0.0, offset]
+        qpos = level_stance_feet(model, qpos, stance, settings)
+        sites = np.stack([ik.frame_positions(q) for q in qpos])
+        residual_cm = 100.0 * np.linalg.norm(sites - targets, axis=-1).mean(axis=1)
+    out = motion_from_qpos(body, qpos, motion.fps)
     out = out.replace(meta={**motion.meta, "retargeted_from": motion.skeleton.name})
-    return Retargeted(result.qpos, out, result.residual_cm)
+    return Retargeted(qpos, out, residual_cm)
+
+
+def stance_feet(positions: np.ndarray, fps: float) -> np.ndarray:
+    """``(T, 2)`` whether the left and right foot stand in body17 ``positions (T, 17, 3)``
+    (:data:`STANCE_HEIGHT_M`, :data:`STANCE_SPEED_M_S`)."""
+    ankle = positions[:, [INDEX[a] for a, _ in FOOT_SITES]]
+    toe_z = positions[:, [INDEX[t] for _, t in FOOT_SITES], 2]
+    speed = np.linalg.norm(np.gradient(ankle[..., :2], 1.0 / fps, axis=0), axis=-1)
+    low = toe_z < toe_z.min(axis=0) + STANCE_HEIGHT_M
+    return low & (speed < STANCE_SPEED_M_S)
+
+
+def sole_offset(model, positions: np.ndarray, stance: np.ndarray) -> float:
+    """How far (m) the source's standing ankles are above the humanoid's flat-footed ones:
+    median over the ``stance (T, 2)`` frames of body17 ``positions (T, 17, 3)``. A source
+    floor at the shoe sole (or a thicker foot) puts them higher; the whole motion is moved
+    down by this (a constant floor calibration, not a pose change) so a levelled foot can
+    reach the floor with the leg the source has."""
+    ankles = [BODY17.index(a) for a, _ in FOOT_SITES]
+    rest = HumanoidIK(model, BODY17).frame_positions(model.qpos0)[ankles, 2]
+    heights = positions[:, ankles, 2] - rest
+    return float(np.median(heights[stance])) if stance.any() else 0.0
+
+
+def level_stance_feet(
+    model, qpos: np.ndarray, stance: np.ndarray, settings: IKSettings | None = None
+) -> np.ndarray:
+    """``(T, nq)`` ``qpos`` re-solved with the feet flat on the floor where ``stance (T, 2)``
+    (module docstring); other frames keep their body17 positions and foot orientations."""
+    sites = [s for pair in FOOT_SITES for s in pair]
+    ik = HumanoidIK(model, BODY17, settings=settings)
+    cost = np.where(np.isin(BODY17, sites), FOOT_ORIENTATION_COST, 0.0)
+    levelled = HumanoidIK(model, BODY17, orientation_cost=cost, settings=settings)
+    ids = [BODY17.index(s) for s in sites]
+    rest = ik.frame_positions(model.qpos0)[ids]  # flat-footed on the floor
+    n = qpos.shape[0]
+    positions = np.empty((n, len(BODY17), 3))
+    orientations = np.tile([1.0, 0.0, 0.0, 0.0], (n, len(BODY17), 1))
+    data = ik.configuration.data
+    for t in range(n):  # MuJoCo evaluates one configuration per call
+        positions[t] = ik.frame_positions(qpos[t])
+        for k in ids:
+            mujoco.mju_mat2Quat(orientations[t, k], data.site_xmat[model.site(BODY17[k]).id])
+    positions[:, ids, 2] = np.maximum(positions[:, ids, 2], rest[:, 2])
+    for side, (ankle, toe) in enumerate(FOOT_SITES):
+        a, b = BODY17.index(ankle), BODY17.index(toe)
+        on = stance[:, side]
+        forward = positions[on, b, :2] - positions[on, a, :2]
+        rest_foot = rest[2 * side + 1] - rest[2 * side]
+        yaw = np.arctan2(forward[:, 1], forward[:, 0]) - np.arctan2(rest_foot[1], rest_foot[0])
+        flat = Rotation.from_euler("z", yaw[:, None])
+        orientations[on, a] = orientations[on, b] = quat.from_scipy(flat)
+        positions[on, a, 2] = rest[2 * side, 2]
+        positions[on, b] = positions[on, a] + flat.apply(rest_foot)
+    return levelled.solve(positions, orientations, q_init=qpos[0]).qpos
