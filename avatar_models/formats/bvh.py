@@ -18,13 +18,16 @@ Reading gives a :class:`Motion` in metres, Z up, rest pose facing +X:
 - Axes: ``up="y"`` files are turned to Z up by ``C`` (:data:`units.Y_UP_TO_Z_UP`), positions
   ``p -> C p`` and rotations ``R -> C R C^T``; ``up="z"`` keeps the file's axes.
 
-The MOTION block is parsed in one vectorised pass (one ``split`` into a float array plus a
-byte-level count of values per line), which is what makes reading fast. Every malformed
-input raises :class:`MotionFormatError` naming the file and line.
+The MOTION block is parsed in one vectorised pass (``np.loadtxt``'s C parser for plain
+decimal data; otherwise one ``np.fromstring`` plus a byte-level count of values per line) and
+Euler angles become quaternions by one closed-form product for all joints and frames, which
+is what makes reading fast. Every malformed input raises :class:`MotionFormatError` naming
+the file and line.
 """
 
 from __future__ import annotations
 
+import io
 import os
 import re
 import tempfile
@@ -47,6 +50,8 @@ _MOTION_LINE = re.compile(r"^[ \t]*MOTION[ \t\r]*$", re.MULTILINE)
 # Position channels whose peak-to-peak is below this fraction of their magnitude are constant
 # (files print about 6 significant digits, so "constant" values jitter in the last digit).
 _CONSTANT_RTOL = 1e-6
+# Bytes of frame data that the np.loadtxt fast path reads exactly as the checked path does.
+_DECIMAL_BYTES = b"0123456789.+-eE \t\r\n"
 
 
 @dataclass
@@ -202,12 +207,38 @@ def _motion_header(
 def _motion_values(
     data: str, frames: int, n_channels: int, path: Path, first_line: int
 ) -> np.ndarray:
+    """``(frames, n_channels)`` floats of the frame lines.
+
+    Fast path: frame data of plain decimal numbers, spaces, tabs and newlines only is read by
+    ``np.loadtxt`` (its C parser, a third faster than ``np.fromstring``, also checks that every
+    line has as many values as the first). Anything it does not read into finite values of the
+    declared shape, or any other byte, goes to :func:`_checked_motion_values`, which finds the
+    offending line (or reads what the fast path declined, e.g. a lone carriage return).
+    """
+    if not data.encode("utf-8").translate(None, _DECIMAL_BYTES):
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", UserWarning)  # no data: the checked path says so
+                values = np.loadtxt(io.StringIO(data), comments=None, ndmin=2)
+        except ValueError:
+            values = None
+        if values is not None and values.shape == (frames, n_channels):
+            if np.isfinite(values).all():
+                return values
+    return _checked_motion_values(data, frames, n_channels, path, first_line)
+
+
+def _checked_motion_values(
+    data: str, frames: int, n_channels: int, path: Path, first_line: int
+) -> np.ndarray:
     """``(frames, n_channels)`` floats of the frame lines, validated line by line (vectorised)."""
     raw = np.frombuffer(data.encode("utf-8"), dtype=np.uint8)
     space = raw <= 32  # ASCII whitespace and control bytes separate values
     token_starts = np.flatnonzero(~space & np.concatenate([[True], space[:-1]]))
     newlines = np.flatnonzero(raw == 10)
-    per_line = np.bincount(np.searchsorted(newlines, token_starts), minlength=newlines.size + 1)
+    # Tokens per line from where each newline falls among the (sorted) token starts: a search
+    # of the few newlines among the many tokens, not the other way round.
+    per_line = np.diff(np.searchsorted(token_starts, newlines), prepend=0, append=token_starts.size)
     rows = np.flatnonzero(per_line)
     if rows.size < frames:
         last = first_line + (int(rows[-1]) if rows.size else 0)
@@ -250,18 +281,49 @@ def _motion_values(
     return values
 
 
+def _euler_quaternions(half: np.ndarray, axes: np.ndarray) -> np.ndarray:
+    """``(T, J, 4)`` wxyz of the intrinsic rotations ``q = qa qb qc`` about ``axes (J, 3)`` (a
+    permutation of 0, 1, 2 per joint) by the half angles ``half (T, J, 3)``, in closed form.
+
+    With ``e = +1`` for cyclic orders (``e_a x e_b = e_c``) and -1 otherwise, expanding the two
+    Hamilton products of elementary quaternions gives
+    ``w = ca cb cc - e sa sb sc``, ``a = sa cb cc + e ca sb sc``, ``b = ca sb cc - e sa cb sc``,
+    ``c = ca cb sc + e sa sb cc`` (for XYZ the textbook Tait-Bryan formula).
+    """
+    c, s = np.cos(half), np.sin(half)
+    ca, cb, cc = c[..., 0], c[..., 1], c[..., 2]
+    sa, sb, sc = s[..., 0], s[..., 1], s[..., 2]
+    e = np.where((axes[:, 1] - axes[:, 0]) % 3 == 1, 1.0, -1.0)  # (J,) cyclic or not
+    ca_cb, sa_sb, sa_cb, ca_sb = ca * cb, sa * sb, sa * cb, ca * sb
+    n_frames, n_joints = half.shape[:2]
+    out = np.empty((n_frames, n_joints, 4))
+    out[..., 0] = ca_cb * cc - e * sa_sb * sc
+    vec = np.stack(
+        [sa_cb * cc + e * ca_sb * sc, ca_sb * cc - e * sa_cb * sc, ca_cb * sc + e * sa_sb * cc],
+        axis=-1,
+    )
+    # Scatter slot k of joint j to component 1 + axes[j, k]: one flat fancy assignment
+    # (take_along_axis over a small last axis costs ten times more).
+    target = 4 * np.arange(n_joints)[:, None] + 1 + axes
+    out.reshape(n_frames, -1)[:, target.ravel()] = vec.reshape(n_frames, -1)
+    return out
+
+
 def _split_channels(joints: list[_Joint], values: np.ndarray) -> tuple[list, np.ndarray]:
     """Per joint: its position ``(T, 3)`` (None without position channels), and the local
     rotations ``(T, J, 4)`` wxyz, composed as intrinsic Euler rotations in channel order
-    (``q = q1 q2 q3``) in one vectorised pass over all joints (up to 3 slots, identity-padded).
+    (``q = q1 q2 q3``) in one vectorised pass over all joints. A joint with fewer than three
+    rotation channels gets its missing axes last, at angle 0, so every joint's order is a
+    permutation of XYZ (:func:`_euler_quaternions`).
     """
     n_frames = values.shape[0]
-    slot_col = np.full((len(joints), 3), -1)
+    zero_col = values.shape[1]  # an appended column of zeros: the angle of a missing axis
+    slot_col = np.full((len(joints), 3), zero_col)
     slot_axis = np.zeros((len(joints), 3), dtype=int)
     positions: list[np.ndarray | None] = []
     col = 0
     for j, joint in enumerate(joints):
-        pos, k = None, 0
+        pos, axes = None, []
         for name in joint.channels:
             kind, axis = _CHANNELS[name]
             if kind == "position":
@@ -269,27 +331,21 @@ def _split_channels(joints: list[_Joint], values: np.ndarray) -> tuple[list, np.
                     pos = np.broadcast_to(joint.offset, (n_frames, 3)).copy()
                 pos[:, "XYZ".index(axis)] = values[:, col]
             else:
-                slot_col[j, k], slot_axis[j, k] = col, "XYZ".index(axis)
-                k += 1
+                slot_col[j, len(axes)] = col
+                axes.append("XYZ".index(axis))
             col += 1
+        slot_axis[j] = axes + [a for a in range(3) if a not in axes]
         positions.append(pos)
-    half = np.where(slot_col >= 0, np.radians(values[:, slot_col]) * 0.5, 0.0)  # (T, J, 3)
-    elementary = np.zeros((n_frames, len(joints), 3, 4))
-    elementary[..., 0] = np.cos(half)
-    np.put_along_axis(
-        elementary[..., 1:],
-        np.broadcast_to(slot_axis[None, :, :, None], half.shape + (1,)),
-        np.sin(half)[..., None],
-        axis=-1,
-    )
-    rot = quat.mul(quat.mul(elementary[:, :, 0], elementary[:, :, 1]), elementary[:, :, 2])
-    return positions, rot
+    padded = np.concatenate([values, np.zeros((n_frames, 1))], axis=1)
+    half = padded[:, slot_col] * (np.pi / 360.0)  # (T, J, 3) half angles in radians
+    return positions, _euler_quaternions(half, slot_axis)
 
 
-def _is_constant(a: np.ndarray) -> bool:
-    """True when every column of ``a (T, k)`` is constant up to print precision."""
+def _is_constant(a: np.ndarray) -> np.ndarray:
+    """``a (T, ..., k)`` -> ``(...)`` bool: every one of the ``k`` columns is constant over
+    time up to print precision."""
     scale = np.maximum(1.0, np.abs(a).max(axis=0))
-    return bool(np.all(np.ptp(a, axis=0) <= _CONSTANT_RTOL * scale))
+    return np.all(np.ptp(a, axis=0) <= _CONSTANT_RTOL * scale, axis=-1)
 
 
 def _root_and_offsets(
@@ -306,13 +362,12 @@ def _root_and_offsets(
         present = np.isin(["Xposition", "Yposition", "Zposition"], root.channels)
         root_pos = positions[0] + root.offset * present
     folded = ""
-    for j in range(1, len(joints)):
+    placed = [j for j in range(1, len(joints)) if positions[j] is not None]
+    stacked = np.stack([positions[j] for j in placed], axis=1) if placed else np.zeros((1, 0, 3))
+    constant = _is_constant(stacked)  # all joints in one pass: Bandai files place every joint
+    offsets[placed] = np.where(constant[:, None], stacked.mean(axis=0), offsets[placed])
+    for j in np.array(placed)[~constant]:
         pos = positions[j]
-        if pos is None:
-            continue
-        if _is_constant(pos):
-            offsets[j] = pos.mean(axis=0)
-            continue
         root_turns = not _is_constant(rot[:, 0])
         only_child = [k for k in range(len(joints)) if joints[k].parent == 0] == [j]
         if joints[j].parent == 0 and not root_turns and only_child:
