@@ -280,3 +280,15 @@ def test_non_utf8_bytes_are_a_format_error(tmp_path):
 def test_missing_file_is_a_format_error(tmp_path):
     with pytest.raises(MotionFormatError, match="cannot read"):
         read_bvh(tmp_path / "absent.bvh")
+
+
+@pytest.mark.parametrize("fmt, newline", [("%.6f", "\n"), ("%.10g", "\r\n"), ("%.3e", "\n")])
+def test_fast_and_checked_frame_parsers_agree_bit_for_bit(tmp_path, fmt, newline):
+    from avatar_models.formats.bvh import _checked_motion_values, _motion_values
+
+    values = np.random.default_rng(0).normal(scale=100.0, size=(40, 9))
+    data = newline.join("\t".join(fmt % v for v in row) for row in values) + newline
+    fast = _motion_values(data, 40, 9, tmp_path / "x.bvh", 1)
+    checked = _checked_motion_values(data, 40, 9, tmp_path / "x.bvh", 1)
+    assert fast.tobytes() == checked.tobytes()
+    np.testing.assert_allclose(fast, values, rtol=1e-2 if fmt == "%.3e" else 1e-5, atol=1e-5)
