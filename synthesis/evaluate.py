@@ -256,6 +256,19 @@ def turned(trial: Trial, heading_deg: float) -> Motion:
     return trial.motion.rotated_about_z(float(yaw))
 
 
+def database_for(train: Sequence[Trial], headings: int = 1) -> Database:
+    """The fold's database; ``headings > 1`` also holds every training motion turned to
+    ``headings`` equally spaced yaws about Z.
+
+    Beyond the paper: its features are head-relative but not turned with the head (§3.1.2),
+    so a user facing away from every performer finds no window within the KD-tree threshold
+    and the alignment (which only turns found matches) has nothing to work on. Turned copies
+    give the search a match within ``180 / headings`` degrees, which the alignment refines.
+    """
+    yaws = 2.0 * np.pi * np.arange(headings) / headings
+    return build_database([t.motion.rotated_about_z(float(a)) for t in train for a in yaws])
+
+
 def evaluate_fold(
     fold: Fold,
     options: Options,
@@ -263,12 +276,14 @@ def evaluate_fold(
     ablation: bool = True,
     baseline_cache: dict | None = None,
     heading_deg: float = 0.0,
+    db_headings: int = 1,
 ) -> list[dict]:
     """Per test trial of ``fold``: the method, its ablation variants and the IK baseline.
 
-    ``heading_deg``: turn each test motion by a random yaw up to this (:func:`turned`).
+    ``heading_deg``: turn each test motion by a random yaw up to this (:func:`turned`);
+    ``db_headings``: turned copies of the database (:func:`database_for`).
     """
-    database = build_database([t.motion for t in fold.train])
+    database = database_for(fold.train, db_headings)
     cache = {} if baseline_cache is None else baseline_cache
     rows = []
     for trial in fold.test:
@@ -346,6 +361,7 @@ def run_protocol(
     setup: VRSetup | None = None,
     progress: Callable[[int, int, str], None] | None = None,
     heading_deg: float = 0.0,
+    db_headings: int = 1,
 ) -> dict:
     """Evaluate ``method`` on ``trials`` under ``protocol``.
 
@@ -354,7 +370,8 @@ def run_protocol(
     (hands, upper, lower, full), ``hand_corr`` and ``baseline_hand_corr`` (left, right),
     ``frames_per_s`` and ``baseline_frames_per_s``, ``ablation_full_cm``, ``trials``.
     ``progress(done, total, label)`` is called after every fold. ``heading_deg`` turns each
-    test motion by a random yaw up to this (the database keeps its headings).
+    test motion by a random yaw up to this (the database keeps its headings);
+    ``db_headings > 1`` adds turned copies to each fold's database (:func:`database_for`).
     """
     if method not in METHODS:
         raise EvaluationError(f"unknown method {method!r}; available: {', '.join(METHODS)}")
@@ -367,7 +384,11 @@ def run_protocol(
     rows, failed, cache = [], [], {}
     for i, fold in enumerate(all_folds):
         try:
-            rows.extend(evaluate_fold(fold, METHODS[method], setup, ablation, cache, heading_deg))
+            rows.extend(
+                evaluate_fold(
+                    fold, METHODS[method], setup, ablation, cache, heading_deg, db_headings
+                )
+            )
         except SynthesisError as exc:  # e.g. every training clip fails the correlation filter
             failed.append({"class": fold.cls, "held_out": fold.held_out, "reason": str(exc)})
         if progress is not None:
@@ -387,5 +408,6 @@ def run_protocol(
         "failed_folds": failed,
         "folds": len(all_folds),
         "heading_deg": heading_deg,
+        "db_headings": db_headings,
         "paper": PAPER,
     }

@@ -20,6 +20,8 @@ from scripts.cli_common import JsonOpt, SeedOpt, console, emit_json, err_console
 
 def _table(results: dict) -> Table:
     turned = f", test turned up to {results['heading_deg']:g} deg" if results["heading_deg"] else ""
+    if results["db_headings"] > 1:
+        turned += f", database at {results['db_headings']} headings"
     table = Table(
         title=f"{results['method']} {results['protocol']}{turned} (cm; IK baseline in brackets)"
     )
@@ -65,6 +67,9 @@ def register(app: typer.Typer) -> None:
         heading: Annotated[
             float, typer.Option(help="Turn each test motion by a random yaw up to this (deg).")
         ] = 0.0,
+        db_headings: Annotated[
+            int, typer.Option(help="Database copies turned to this many yaws (beyond the paper).")
+        ] = 1,
         quick: Annotated[bool, typer.Option(help="Small inputs, for a smoke run.")] = False,
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
@@ -106,7 +111,13 @@ def register(app: typer.Typer) -> None:
                 bar.update(task, completed=done, total=total, description=label)
 
             results = run_protocol(
-                trials, protocol, method, ablation, progress=progress, heading_deg=heading
+                trials,
+                protocol,
+                method,
+                ablation,
+                progress=progress,
+                heading_deg=heading,
+                db_headings=db_headings,
             )
         results.update(
             library=library, seed=seed, quick=quick, class_by=class_by, trials_total=len(trials)

@@ -7,11 +7,15 @@ import numpy as np
 import pytest
 
 from avatar_models.generator import Subject, generate
+from render_cams import VRSetup
+from synthesis.coolmoves import Options
 from synthesis.coolmoves.accuracy import body17_errors_cm
 from synthesis.evaluate import (
     EvaluationError,
+    Fold,
     Trial,
     builtin_trials,
+    evaluate_fold,
     folds,
     run_protocol,
     summarise,
@@ -123,3 +127,17 @@ def test_heading_turns_only_the_test_motion():
     )
     assert 0 < abs(np.degrees(np.angle(np.exp(1j * yaw)))) <= 90.0
     np.testing.assert_allclose(out.root_pos[:, 2], motion.root_pos[:, 2])
+
+
+def test_alignment_and_turned_copies_help_a_user_facing_away():
+    """A user turned by 113 deg (seed 3) from the only database subject: unaligned matches
+    face the wrong way, the alignment turns them back; database copies at 8 headings give
+    the search matches within 22.5 deg, which the alignment still refines."""
+    trials = builtin_trials(("box",), n_subjects=2, n_takes=1, duration_s=3.0, seed=3)
+    fold = Fold("box", "1", [trials[0]], [trials[1]])
+    plain = evaluate_fold(fold, Options(), VRSetup(), heading_deg=180.0)[0]["ablation"]
+    copies = evaluate_fold(fold, Options(), VRSetup(), heading_deg=180.0, db_headings=8)
+    copies = copies[0]["ablation"]
+    assert plain["alignment_no_smoothing"] < 0.5 * plain["no_alignment_no_smoothing"]
+    assert copies["no_alignment_no_smoothing"] < 0.5 * plain["no_alignment_no_smoothing"]
+    assert copies["alignment_no_smoothing"] < copies["no_alignment_no_smoothing"] - 1.0
