@@ -22,24 +22,32 @@ CHUNK = 512  # frames per vectorised batch: (CHUNK, K, K, K) floats stay a few M
 
 def outside_margin(points: np.ndarray, active: np.ndarray, p: np.ndarray) -> np.ndarray:
     """``(T,)`` distance of ``p (T, 2)`` outside the convex hull of the ``active (T, K)`` of
-    ``points (T, K, 2)`` (at least 3 non-collinear active points per frame; NaN with none)."""
+    ``points (T, K, 2)`` (at least 3 non-collinear active points per frame; NaN with none).
+
+    With the points ``Q`` taken relative to ``p`` and ``C[i, j] = Q_i x Q_j`` (2D cross), the
+    turn of ``k`` about the edge ``i -> j`` is ``C[i, j] + C[j, k] - C[i, k]`` and the side of
+    ``p`` is ``C[i, j]``, so the edge test over all ``k`` is one subtraction and a minimum over a
+    ``(K, K, K)`` block. Inactive points are moved onto an active one of their frame: a
+    duplicate changes no turn and adds only copies of real edges, so no masks are needed.
+    """
     out = np.full(len(p), np.nan)
+    some = active.any(axis=1)
+    first = np.argmax(active, axis=1)  # an active point of each supported frame
+    stand_in = np.take_along_axis(points, first[:, None, None], axis=1)  # (T, 1, 2)
+    q = np.where(active[..., None], points, stand_in) - p[:, None, :]  # (T, K, 2)
     for a in range(0, len(p), CHUNK):
-        P, m, q = points[a : a + CHUNK], active[a : a + CHUNK], p[a : a + CHUNK]
-        d = P[:, None, :, :] - P[:, :, None, :]  # (t, i, j, 2) edge i -> j
-        rel = P[:, None, :, :] - P[:, :, None, :]  # (t, i, k, 2) point k from i
-        cross = (
-            d[:, :, :, None, 0] * rel[:, :, None, :, 1]
-            - d[:, :, :, None, 1] * rel[:, :, None, :, 0]
-        )  # (t, i, j, k): > 0 when k is left of i -> j
-        length = np.linalg.norm(d, axis=-1)
-        left = (cross >= -1e-9 * length[..., None]) | ~m[:, None, None, :]
-        edge = left.all(axis=-1) & m[:, :, None] & m[:, None, :] & (length > 1e-9)
-        to_p = q[:, None, :] - P  # (t, i, 2)
-        side = d[..., 0] * to_p[:, :, None, 1] - d[..., 1] * to_p[:, :, None, 0]
-        dist = np.where(edge, -side / np.where(length > 0, length, 1.0), -np.inf)
-        best = dist.reshape(len(q), -1).max(axis=1)
+        x, y = q[a : a + CHUNK, :, 0], q[a : a + CHUNK, :, 1]
+        cross = x[:, :, None] * y[:, None, :] - y[:, :, None] * x[:, None, :]  # (t, i, j)
+        worst_turn = np.full(cross.shape, np.inf)  # (t, i, j): min over k, one k at a time
+        for k in range(cross.shape[2]):  # elementwise minimum of whole blocks: vectorises
+            about_k = cross[:, :, k]  # (t, i)
+            np.minimum(worst_turn, about_k[:, None, :] - about_k[:, :, None], out=worst_turn)
+        length = np.hypot(x[:, None, :] - x[:, :, None], y[:, None, :] - y[:, :, None])
+        edge = (worst_turn + cross >= -1e-9 * length) & (length > 1e-9)
+        dist = np.where(edge, -cross / np.where(length > 0, length, 1.0), -np.inf)
+        best = dist.reshape(len(x), -1).max(axis=1)
         out[a : a + CHUNK] = np.where(np.isfinite(best), np.maximum(best, 0.0), np.nan)
+    out[~some] = np.nan
     return out
 
 
