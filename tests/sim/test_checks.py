@@ -90,3 +90,18 @@ def test_support_margin_matches_scipy_convex_hull():
         eq = ConvexHull(points[t, active[t]]).equations
         expected.append(max(0.0, np.max(eq[:, :2] @ com[t] + eq[:, 2])))
     np.testing.assert_allclose(outside_margin(points, active, com), expected, atol=1e-9)
+
+
+def test_support_margin_is_translation_invariant_and_nan_without_support():
+    from sim.checks.support import outside_margin
+
+    rng = np.random.default_rng(4)
+    points = rng.uniform(-0.2, 0.2, size=(50, 16, 2))
+    active = rng.random((50, 16)) < 0.7
+    active[:, :3] = True
+    active[7] = False  # no support in frame 7
+    com = rng.uniform(-0.4, 0.4, size=(50, 2))
+    near = outside_margin(points, active, com)
+    far = np.array([80.0, -40.0])  # a minute of walking away from the origin
+    np.testing.assert_allclose(outside_margin(points + far, active, com + far), near, atol=1e-9)
+    assert np.isnan(near[7]) and np.isfinite(np.delete(near, 7)).all()
