@@ -90,23 +90,27 @@ def replay_kinematic(model: mujoco.MjModel, qpos: np.ndarray) -> ReplayTrace:
     body_rot = np.empty((n, model.nbody, 9))
     geom_xpos = np.empty((n, model.ngeom, 3))
     geom_xmat = np.empty((n, model.ngeom, 9))
-    frames, geoms, dists, positions = [], [], [], []
+    # Views of MjData's buffers fetched once: each attribute access builds a new array object,
+    # which costs as much as the copy itself at this size.
+    q_in, xpos, xmat, gpos, gmat = data.qpos, data.xpos, data.xmat, data.geom_xpos, data.geom_xmat
+    counts = np.zeros(n, dtype=np.int64)
+    geoms, dists, positions = [], [], []
     for t in range(n):  # MuJoCo evaluates one configuration per call
-        data.qpos[:] = qpos[t]
+        q_in[:] = qpos[t]
         mujoco.mj_kinematics(model, data)
         mujoco.mj_collision(model, data)
-        body_pos[t] = data.xpos
-        body_rot[t] = data.xmat
-        geom_xpos[t] = data.geom_xpos
-        geom_xmat[t] = data.geom_xmat
+        body_pos[t] = xpos
+        body_rot[t] = xmat
+        geom_xpos[t] = gpos
+        geom_xmat[t] = gmat
         if data.ncon:
             con = data.contact
-            frames.append(np.full(data.ncon, t))
+            counts[t] = data.ncon
             geoms.append(con.geom.copy())
             dists.append(con.dist.copy())
             positions.append(con.pos.copy())
     cat = np.concatenate
-    contact_frame = cat(frames) if frames else np.zeros(0, dtype=np.int64)
+    contact_frame = np.repeat(np.arange(n), counts)
     contact_geom = cat(geoms) if geoms else np.zeros((0, 2), dtype=np.int64)
     contact_dist = cat(dists) if dists else np.zeros(0)
     contact_pos = cat(positions) if positions else np.zeros((0, 3))
