@@ -16,6 +16,10 @@ with the IK baseline side by side, hand correlation, the ablation and throughput
   ``frames_per_s`` is the batch ``run`` throughput.
 - Aggregation: a class's numbers are means over its test trials; ``overall`` is the mean over
   classes (each class counts once, as the paper averages over activities).
+- Heading: every generated performer faces +X, so alignment has nothing to correct there.
+  ``heading_deg`` turns each test motion by a random yaw (:func:`turned`), as users and CMU
+  performers face any way; ``db_headings`` adds turned copies to the database
+  (:func:`database_for`, beyond the paper).
 """
 
 from __future__ import annotations

@@ -6,6 +6,12 @@ hemisphere of the previous output and renormalised (nlerp, which for one step of
 filter differs from slerp by far less than the matches differ from each other). A weight of 1
 returns the new pose exactly, 0 holds the previous one; joints with weight 0 are how a hand
 without matches (or tracking) keeps its last pose.
+
+What it buys: the filter trades jitter for lag. With our global match weights (median 0.6 on
+built-in cross-subject boxing and running, so about 0.7 frames of lag) it halves the
+frame-to-frame jitter of the joints (mean second difference 1.7 -> 0.9 cm) and costs about
+0.2 cm of mean error. The paper's 13.2 -> 11.4 cm gain came from real mocap, whose matches
+jump between performers far more than the generator's consistent ones.
 """
 
 from __future__ import annotations
