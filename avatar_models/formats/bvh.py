@@ -309,9 +309,12 @@ def _euler_quaternions(half: np.ndarray, axes: np.ndarray) -> np.ndarray:
     return out
 
 
-def _split_channels(joints: list[_Joint], values: np.ndarray) -> tuple[list, np.ndarray]:
-    """Per joint: its position ``(T, 3)`` (None without position channels), and the local
-    rotations ``(T, J, 4)`` wxyz, composed as intrinsic Euler rotations in channel order
+def _split_channels(
+    joints: list[_Joint], values: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per joint: its position ``(T, J, 3)`` (the OFFSET, with each position channel replacing
+    its axis), which joints have position channels ``(J,)``, and the local rotations
+    ``(T, J, 4)`` wxyz, composed as intrinsic Euler rotations in channel order
     (``q = q1 q2 q3``) in one vectorised pass over all joints. A joint with fewer than three
     rotation channels gets its missing axes last, at angle 0, so every joint's order is a
     permutation of XYZ (:func:`_euler_quaternions`).
@@ -320,25 +323,29 @@ def _split_channels(joints: list[_Joint], values: np.ndarray) -> tuple[list, np.
     zero_col = values.shape[1]  # an appended column of zeros: the angle of a missing axis
     slot_col = np.full((len(joints), 3), zero_col)
     slot_axis = np.zeros((len(joints), 3), dtype=int)
-    positions: list[np.ndarray | None] = []
+    pos_col, pos_slot = [], []  # value column -> flat (joint, axis) slot of the positions
     col = 0
     for j, joint in enumerate(joints):
-        pos, axes = None, []
+        axes = []
         for name in joint.channels:
             kind, axis = _CHANNELS[name]
             if kind == "position":
-                if pos is None:
-                    pos = np.broadcast_to(joint.offset, (n_frames, 3)).copy()
-                pos[:, "XYZ".index(axis)] = values[:, col]
+                pos_col.append(col)
+                pos_slot.append(3 * j + "XYZ".index(axis))
             else:
                 slot_col[j, len(axes)] = col
                 axes.append("XYZ".index(axis))
             col += 1
         slot_axis[j] = axes + [a for a in range(3) if a not in axes]
-        positions.append(pos)
+    offsets = np.array([j.offset for j in joints])
+    positions = np.broadcast_to(offsets.ravel(), (n_frames, offsets.size)).copy()
+    positions[:, pos_slot] = values[:, pos_col]
+    has_position = np.zeros(len(joints), dtype=bool)
+    has_position[np.array(pos_slot, dtype=int) // 3] = True
     padded = np.concatenate([values, np.zeros((n_frames, 1))], axis=1)
     half = padded[:, slot_col] * (np.pi / 360.0)  # (T, J, 3) half angles in radians
-    return positions, _euler_quaternions(half, slot_axis)
+    rot = _euler_quaternions(half, slot_axis)
+    return positions.reshape(n_frames, len(joints), 3), has_position, rot
 
 
 def _is_constant(a: np.ndarray) -> np.ndarray:
@@ -349,25 +356,30 @@ def _is_constant(a: np.ndarray) -> np.ndarray:
 
 
 def _root_and_offsets(
-    joints: list[_Joint], positions: list, rot: np.ndarray, values: np.ndarray, path: Path
+    joints: list[_Joint],
+    positions: np.ndarray,
+    has_position: np.ndarray,
+    rot: np.ndarray,
+    path: Path,
 ) -> tuple[np.ndarray, np.ndarray, str]:
     """Root trajectory ``(T, 3)``, offsets ``(J, 3)`` (file units) and the folded joint's name.
 
+    ``positions (T, J, 3)``, ``has_position (J,)``: from :func:`_split_channels`;
     ``rot (T, J, 4)``: local rotations in the file's axes.
     """
     offsets = np.array([j.offset for j in joints])
     root = joints[0]
-    root_pos = np.broadcast_to(root.offset, (values.shape[0], 3)).copy()
-    if positions[0] is not None:  # the root's channels add to its OFFSET
+    root_pos = positions[:, 0].copy()
+    if has_position[0]:  # the root's channels add to its OFFSET
         present = np.isin(["Xposition", "Yposition", "Zposition"], root.channels)
-        root_pos = positions[0] + root.offset * present
+        root_pos += root.offset * present
     folded = ""
-    placed = [j for j in range(1, len(joints)) if positions[j] is not None]
-    stacked = np.stack([positions[j] for j in placed], axis=1) if placed else np.zeros((1, 0, 3))
+    placed = np.flatnonzero(has_position[1:]) + 1
+    stacked = positions[:, placed]
     constant = _is_constant(stacked)  # all joints in one pass: Bandai files place every joint
     offsets[placed] = np.where(constant[:, None], stacked.mean(axis=0), offsets[placed])
-    for j in np.array(placed)[~constant]:
-        pos = positions[j]
+    for j in placed[~constant]:
+        pos = positions[:, j]
         root_turns = not _is_constant(rot[:, 0])
         only_child = [k for k in range(len(joints)) if joints[k].parent == 0] == [j]
         if joints[j].parent == 0 and not root_turns and only_child:
@@ -421,8 +433,8 @@ def read_bvh(path: str | Path, unit: str | float | None = None, up: str = "y") -
         text, found.end() + 1, motion_line + 1, path
     )
     values = _motion_values(text[start:], frames, n_channels, path, first_line)
-    positions, rot = _split_channels(joints, values)
-    root_pos, offsets, folded = _root_and_offsets(joints, positions, rot, values, path)
+    positions, has_position, rot = _split_channels(joints, values)
+    root_pos, offsets, folded = _root_and_offsets(joints, positions, has_position, rot, path)
 
     axes = Y_UP_TO_Z_UP if up == "y" else np.eye(3)
     offsets, root_pos = offsets @ axes.T, root_pos @ axes.T
