@@ -81,17 +81,22 @@ def swing_between(
     clearance: float,
     pitch_start: float = 0.0,
     pitch_end: float = 0.0,
+    lift: float = SWING_LIFT,
+    hang: float = 0.0,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A swing from ball pivot ``start (T, 3)`` pitched ``pitch_start`` to heel pivot
     ``end (T, 3)`` pitched ``pitch_end``, over ``tau (T,)`` in [0, 1]; the ankle is lifted by
-    ``clearance * sin(pi tau)``. Returns ankle, foot rotation, toe rotation."""
+    ``clearance * sin(pi tau)`` and travels after a straight lift over the first ``lift`` of
+    the swing (:func:`~.curves.swing_progress`); the foot pitches toes-down by a further
+    ``hang * sin^2(pi s)`` (``s`` the horizontal progress: smooth, and none while lifting),
+    hanging from a knee that flexes in mid-swing. Returns ankle, foot rotation, toe rotation."""
     n = tau.shape[0]
     a0, _, toe0 = foot_pose(geom, start, np.full(n, pitch_start), np.ones(n, bool))
     a1, _, _ = foot_pose(geom, end, np.full(n, pitch_end), np.zeros(n, bool))
-    s = swing_progress(tau, SWING_LIFT)
+    s = swing_progress(tau, lift)
     ankle = a0 + (a1 - a0) * s[:, None]
     ankle[:, 2] += clearance * bump(tau)
-    pitch = pitch_start + (pitch_end - pitch_start) * s
+    pitch = pitch_start + (pitch_end - pitch_start) * s + hang * bump(s) ** 2
     toe = axis_rotation(Y_AXIS, -pitch_start * (1.0 - s))
     return ankle, axis_rotation(Y_AXIS, pitch), toe
 
@@ -105,6 +110,8 @@ def gait_track(
     heel_rocker: float,
     toe_off: float,
     clearance: float,
+    lift: float = SWING_LIFT,
+    hang: float = 0.0,
 ) -> FootTrack:
     """One foot of a cyclic gait (walk, run).
 
@@ -115,6 +122,8 @@ def gait_track(
             footprints; in cycle ``k`` the foot stands on footprint ``k``, then swings to ``k + 1``.
         heel_rocker, toe_off: foot pitch (radians) at heel strike (toes up) and toe-off.
         clearance: ankle lift at mid-swing (metres).
+        lift: fraction of the swing spent lifting straight up and setting straight down.
+        hang: extra toe-down pitch of the foot at mid-swing (radians), see :func:`swing_between`.
     """
     geom = FootGeometry.of(scene)
     cycle, ph = phase(scene.times, frequency, offset)
@@ -131,7 +140,7 @@ def gait_track(
     ankle, rot, toe = foot_pose(geom, pivot, pitch, on_ball)
     tau = (ph - duty) / (1.0 - duty)
     s_ankle, s_rot, s_toe = swing_between(
-        geom, tau, here + geom.ball, nxt + geom.heel, clearance, toe_off, -heel_rocker
+        geom, tau, here + geom.ball, nxt + geom.heel, clearance, toe_off, -heel_rocker, lift, hang
     )
     return FootTrack(
         np.where(stance[:, None], ankle, s_ankle),

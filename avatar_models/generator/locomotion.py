@@ -6,17 +6,26 @@ what the legs can reach; the trunk counter-rotates, arms swing opposite the legs
 Cadence and stride defaults: walking about 0.95 strides/s with a stride of 0.78 stature
 (about 1.35 m/s for 1.75 m; Grieve & Gear 1966, Perry & Burnfield ch. 1); running about
 1.4 strides/s with 1.3 statures per stride (about 3.2 m/s; Novacheck 1998, Gait & Posture 7).
+
+Running moves the whole-body centre of mass, not the pelvis, on a spring-mass path (constant
+speed, ballistic flights): the swinging legs carry a sixth of the mass each, so a pelvis on
+that path puts their momentum changes on a floor the body is not touching. The running swing
+lifts the heel high behind (ankle 0.17 statures up at mid-swing: a tightly folded leg
+swings through with less inertia, Novacheck 1998) and the foot hangs toes-down from the
+flexed knee.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from avatar_models.generator.bounce import spring_mass_bounce, vaulting_bob
+from avatar_models.generator.com import follow_centre_of_mass, plan_centre_of_mass
 from avatar_models.generator.curves import smooth_cap
-from avatar_models.generator.feet import gait_track, pelvis_height_limit
+from avatar_models.generator.feet import SWING_LIFT, gait_track, pelvis_height_limit
 from avatar_models.generator.ik import euler
 from avatar_models.generator.plan import LimbTarget, Plan, Scene
 from avatar_models.generator.poses import arm_angles, gaze, heading_rotation, trunk
@@ -36,18 +45,24 @@ class Gait:
     heel_rocker: float
     toe_off: float
     clearance: float  # ankle lift at mid-swing / stature
+    swing_lift: float  # fraction of the swing lifting straight up and setting down
+    swing_hang: float  # extra toe-down foot pitch at mid-swing (the knee flexes under it)
     bob: float  # pelvis vertical oscillation / stature
     crouch: float  # pelvis lowered / leg length
-    running: bool  # pelvis lowest at mid-stance (spring-mass) instead of highest (vaulting)
+    running: bool  # centre of mass on a spring-mass path instead of a vaulting pelvis
     pelvis_yaw: float
     arm_swing: float
     elbow: float
     lean: float
 
 
-WALK = Gait(0.95, 0.78, (0.85, 1.7), 0.62, 12, 30, 0.055, 0.012, 0.03, False, 5, 18, 15, 2)
-RUN = Gait(1.4, 1.3, (2.2, 4.5), 0.38, 4, 35, 0.11, 0.03, 0.08, True, 8, 30, 85, 8)
-DRIBBLE = Gait(0.85, 0.55, (0.6, 1.1), 0.64, 10, 25, 0.05, 0.01, 0.08, False, 4, 10, 40, 12)
+WALK = Gait(
+    0.95, 0.78, (0.85, 1.7), 0.62, 12, 30, 0.055, SWING_LIFT, 0, 0.012, 0.03, False, 5, 18, 15, 2
+)
+RUN = Gait(1.4, 1.3, (2.2, 4.5), 0.38, 4, 35, 0.17, 0.06, 65, 0.03, 0.08, True, 8, 30, 85, 8)
+DRIBBLE = Gait(
+    0.85, 0.55, (0.6, 1.1), 0.64, 10, 25, 0.05, SWING_LIFT, 0, 0.01, 0.08, False, 4, 10, 40, 12
+)
 
 
 def _gait_plan(scene: Scene, gait: Gait) -> tuple[Plan, np.ndarray]:
@@ -80,6 +95,8 @@ def _gait_plan(scene: Scene, gait: Gait) -> tuple[Plan, np.ndarray]:
                 np.radians(gait.heel_rocker),
                 np.radians(gait.toe_off),
                 gait.clearance * height * style.amplitude,
+                gait.swing_lift,
+                np.radians(gait.swing_hang),
             )
         )
     phase_l = (t * frequency) % 1.0
@@ -128,7 +145,47 @@ def _gait_plan(scene: Scene, gait: Gait) -> tuple[Plan, np.ndarray]:
         legs=legs,
         fist=np.full((n, 2), 0.5 if gait.running else 0.2),
     )
+    if gait.running:
+        plan.root_pos = _spring_mass_root(
+            scene,
+            plan,
+            speed * t - start_x,
+            bob,
+            lambda xy: pelvis_height_limit(scene, xy, root_rot @ pelvis, ankles),
+        )
     return plan, phase_l
+
+
+def _spring_mass_root(
+    scene: Scene,
+    plan: Plan,
+    travel: np.ndarray,
+    bounce: np.ndarray,
+    limit_of: Callable[[np.ndarray], np.ndarray],
+) -> np.ndarray:
+    """``(T, 3)`` root positions that make the centre of mass, not the pelvis, travel
+    ``travel (T,)`` at constant speed, straight, and bounce by ``bounce (T,)``: ballistic in
+    flight, a spring in stance. The bounce's level is as high as the plan's pelvis but low
+    enough that the legs reach the ground: the root stays under ``limit_of(root_xy (T, 2))
+    (T,)``. Moving the root horizontally changes that limit, so level and path are found
+    twice."""
+    root = plan.root_pos
+    for _ in range(2):
+        com = plan_centre_of_mass(scene, replace(plan, root_pos=root))
+        offset = com - root
+        level = min(
+            np.mean(plan.root_pos[:, 2] - bounce + offset[:, 2]),
+            np.min(limit_of(root[:, :2]) - bounce + offset[:, 2]),
+        )
+        wanted = np.column_stack(
+            [
+                travel + offset[:, 0].mean(),
+                np.full(scene.n_frames, com[:, 1].mean()),
+                level + bounce,
+            ]
+        )
+        root = follow_centre_of_mass(scene, replace(plan, root_pos=root), wanted)
+    return root
 
 
 def walk(scene: Scene) -> Plan:

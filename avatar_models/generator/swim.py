@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from avatar_models.generator.ik import axis_rotation
-from avatar_models.generator.plan import Plan, Scene, sided
-from avatar_models.generator.poses import X_AXIS, Y_AXIS, Z_AXIS
+from avatar_models.generator.plan import LimbTarget, Plan, Scene, realise
+from avatar_models.generator.poses import X_AXIS, Y_AXIS
 
 TAU = 2.0 * np.pi
 
@@ -31,15 +31,7 @@ def swim(scene: Scene) -> Plan:
     speed = 1.0 * style.tempo * np.sqrt(amp)
     root = np.column_stack([speed * (t - t[0]), np.zeros(n), np.full(n, 0.5 * height)])
     joints = {}
-    for side, offset in (("L", 0.0), ("R", 0.5)):
-        u = (cycle + offset) % 1.0
-        # Faster underwater pull than recovery: warp the phase so the pull takes about 45 %.
-        psi = TAU * (u + 0.05 * np.sin(TAU * u))
-        upper = axis_rotation(Y_AXIS, psi) @ axis_rotation(X_AXIS, np.full(n, np.pi / 2))
-        # Elbow: a moderate bend through the pull (high-elbow catch), a strong one in recovery.
-        elbow = np.where(np.sin(psi) > 0, 0.6 * np.sin(psi), -1.5 * np.sin(psi))
-        joints[f"Bip01 {side} UpperArm"] = sided(upper, side)
-        joints[f"Bip01 {side} Forearm"] = sided(axis_rotation(Z_AXIS, -elbow), side)
+    for side in ("L", "R"):
         # Six-beat kick: three kicks per leg per stroke cycle, legs in antiphase.
         kick = np.sin(TAU * 3.0 * cycle + (0.0 if side == "L" else np.pi))
         joints[f"Bip01 {side} Thigh"] = axis_rotation(
@@ -55,7 +47,7 @@ def swim(scene: Scene) -> Plan:
     head = axis_rotation(X_AXIS, 0.5 * roll - breath) @ axis_rotation(
         Y_AXIS, np.full(n, np.pi / 2 - 0.35)
     )
-    return Plan(
+    plan = Plan(
         root_pos=root,
         root_rot=root_rot,
         pelvis=scene.constant(np.eye(3)),
@@ -65,3 +57,36 @@ def swim(scene: Scene) -> Plan:
         joints=joints,
         fist=np.full((n, 2), 0.1),
     )
+    shoulders = realise(scene, plan).global_positions()
+    for side, offset in (("L", 0.0), ("R", 0.5)):
+        u = (cycle + offset) % 1.0
+        # Faster underwater pull than recovery: warp the phase so the pull takes about 45 %.
+        psi = TAU * (u + 0.05 * np.sin(TAU * u))
+        reach = sum(np.linalg.norm(scene.offset(f"Bip01 {side} {j}")) for j in ("Forearm", "Hand"))
+        hand, pole = _stroke(psi, side)
+        shoulder = shoulders[:, scene.skeleton.index(f"Bip01 {side} UpperArm")]
+        plan.arms[side] = LimbTarget(
+            shoulder + np.einsum("tab,tb->ta", root_rot, reach * hand),
+            np.einsum("tab,tb->ta", root_rot, pole),
+        )
+    return plan
+
+
+def _stroke(psi: np.ndarray, side: str) -> tuple[np.ndarray, np.ndarray]:
+    """Hand position relative to the shoulder (arm lengths) and elbow pole direction, both
+    ``(T, 3)`` in the trunk's frame (x ventral, y left, z towards the head), at stroke angle
+    ``psi (T,)``: 0 at hand entry ahead of the head, the pull under the body while
+    ``sin(psi) > 0``, the recovery above the water while it is negative.
+
+    The hand sweeps in under the body's midline while pulling and exits at the hip; the
+    recovery brings it forward out to the side with the elbow high (the humerus rotated
+    inwards, elbow pointing to the sky), and the elbow points sideways through the pull (a
+    high-elbow catch; Maglischo 2003, *Swimming Fastest*, ch. 5). The hand's loop goes round
+    the side, not over the shoulder, so the arm never turns a full circle about one axis.
+    """
+    sin, cos = np.sin(psi), np.cos(psi)
+    hand = np.column_stack([0.35 + 0.2 * sin, 0.25 - 0.4 * sin, 0.85 * cos])
+    recovery = (1.0 - sin)[:, None] / 2.0
+    pole = (1.0 - recovery) * [-0.3, 1.0, 0.0] + recovery * [-1.0, 0.5, 0.0]
+    mirror = np.array([1.0, 1.0 if side == "L" else -1.0, 1.0])
+    return hand * mirror, pole * mirror

@@ -7,21 +7,20 @@ and no water to hold the body up).
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 import pytest
 
+from avatar_models.body import build_body
 from avatar_models.generator import ACTIVITIES, Subject, generate, sample_subject
 from sim.plausibility import check_motion
 
 SUBJECTS = (Subject(), Subject(height_m=1.93, style="energetic", leg_factor=1.05))
 UNSUPPORTED = {"climb_ladder", "swim"}  # no ladder or water in the physics scene
 EXPECTED_FAILURES = {"floating", "residual_force"}
-# Known gaps, strict so that a fix shows up. Running needs a centre-of-mass (not pelvis)
-# spring-mass trajectory and ankle angles within range at toe-off; the fast long-legged
-# walker's swing foot travels a 1.5 m stride in 0.25 s, whose horizontal force the floor
-# cannot give while the pelvis falls; the front crawl's arm circles the shoulder a full turn
-# per stroke, which the shoulder's Euler hinges cannot follow without winding past range.
-KNOWN_GAPS = {("run", 0), ("run", 1), ("walk", 1), ("swim", 0), ("swim", 1)}
+# Known gaps, strict so that a fix shows up. The fast long-legged walker's swing foot travels
+# a 1.5 m stride in 0.25 s, whose horizontal force the floor cannot give while the pelvis falls.
+KNOWN_GAPS = {("walk", 1)}
 
 
 @pytest.mark.parametrize(
@@ -41,12 +40,28 @@ def test_generated_activity_is_physically_plausible(activity, i):
     assert not unexpected, (activity, i, report.failed_checks, report.contract()["details"])
 
 
-def test_pelvis_height_is_smooth_in_walking_and_running():
-    """Vertical pelvis acceleration (second differences, no filtering) within the human
-    range: about +-0.3 g walking (vaulting), at most -1 g (free fall) running."""
+def _centre_of_mass_height(motion) -> np.ndarray:
+    """``(T,)`` whole-body centre of mass height, from MuJoCo's model of the body."""
+    body = build_body(motion.skeleton)
+    model = mujoco.MjModel.from_xml_string(body.to_mjcf())
+    data = mujoco.MjData(model)
+    heights = []
+    for qpos in body.qpos_from_motion(motion):
+        data.qpos[:] = qpos
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_comPos(model, data)
+        heights.append(data.subtree_com[0, 2])
+    return np.array(heights)
+
+
+def test_vertical_motion_is_smooth_in_walking_and_running():
+    """Vertical acceleration (second differences, no filtering) within the human range: the
+    walking pelvis about +-0.3 g (vaulting); the running body's centre of mass at most -1 g
+    (free fall; its pelvis drops faster while the legs fold under it)."""
     for activity, lowest_g in (("walk", -0.4), ("run", -1.05)):
         for i, subject in enumerate((*SUBJECTS, sample_subject(np.random.default_rng(3)))):
             motion = generate(activity, subject, duration_s=3.0, seed=i)
-            accel_g = np.diff(motion.root_pos[:, 2], 2) * motion.fps**2 / 9.81
+            z = motion.root_pos[:, 2] if activity == "walk" else _centre_of_mass_height(motion)
+            accel_g = np.diff(z, 2) * motion.fps**2 / 9.81
             assert accel_g.min() > lowest_g, (activity, i, accel_g.min())
             assert accel_g.max() < 3.0, (activity, i, accel_g.max())
