@@ -36,7 +36,10 @@ def write_plots(results: dict, out: Path) -> dict[str, str]:
     out.mkdir(parents=True, exist_ok=True)
     title = f"{results['method']} {results['protocol']}"
     if results.get("heading_deg"):
-        title += f", test turned up to {results['heading_deg']:g} deg"
+        # A second line: the conditions would not fit beside the plot's own title.
+        title += f"\ntest turned up to {results['heading_deg']:g} deg"
+    if results.get("db_headings", 1) > 1:
+        title += f", database at {results['db_headings']} headings"
     overall, per_class = results["overall"], results["per_activity"]
     written = {}
 
@@ -74,7 +77,8 @@ def write_plots(results: dict, out: Path) -> dict[str, str]:
         series = {"ours": [overall["ablation_full_cm"][s] for s in steps]}
         if results["protocol"] == "cross-subject":
             series["paper"] = list(results["paper"]["ablation_full_cm"])
-        _bars(ax, [s.replace("_", " ") for s in steps], series, "full-body error (cm)")
+        labels = [s.replace("_no_", "\nno ").replace("_", " ") for s in steps]
+        _bars(ax, labels, series, "full-body error (cm)")
         ax.set_title(f"{title}: ablation")
         written["ablation"] = _save(fig, out / "ablation.png")
     return written
