@@ -46,14 +46,17 @@ PUNCHES = {
             GUARD,
         ),
     ),
+    # The rear hand guards the chin, which the hook's trunk turn carries to the right: a hand
+    # held at the guard's place would pull the rear arm across the chest, rotated inwards past
+    # its range.
     "hook": (
         0.65,
         (0.0, 0.3, 0.55, 0.7, 1.0),
         (
             GUARD,
             _pose((0.25, 0.32, 1.40), (0.20, -0.10, 1.47), 0.15, 0.02, ELBOW_OUT),
-            _pose((0.45, -0.02, 1.45), (0.20, -0.12, 1.47), -0.5, 0.02, ELBOW_OUT),
-            _pose((0.45, -0.02, 1.45), (0.20, -0.12, 1.47), -0.5, 0.02, ELBOW_OUT),
+            _pose((0.45, -0.02, 1.45), (0.12, -0.22, 1.45), -0.5, 0.02, ELBOW_OUT),
+            _pose((0.45, -0.02, 1.45), (0.12, -0.22, 1.45), -0.5, 0.02, ELBOW_OUT),
             GUARD,
         ),
     ),
