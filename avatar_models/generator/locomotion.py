@@ -7,10 +7,9 @@ Cadence and stride defaults: walking about 0.95 strides/s with a stride of 0.78 
 (about 1.35 m/s for 1.75 m; Grieve & Gear 1966, Perry & Burnfield ch. 1); running about
 1.4 strides/s with 1.3 statures per stride (about 3.2 m/s; Novacheck 1998, Gait & Posture 7).
 
-The whole-body centre of mass, not the pelvis, travels at constant speed, and in running
-also bounces on a spring-mass path (ballistic flights): the swinging legs carry a sixth of
-the mass each, so a pelvis at constant speed asks the floor (or, in flight, nothing) for
-their momentum changes. The running swing
+Running moves the whole-body centre of mass, not the pelvis, on a spring-mass path (constant
+speed, ballistic flights): the swinging legs carry a sixth of the mass each, so a pelvis on
+that path asks a floor the body is not touching for their momentum changes. The running swing
 lifts the heel high behind (ankle 0.17 statures up at mid-swing: a tightly folded leg
 swings through with less inertia, Novacheck 1998) and the foot hangs toes-down from the
 flexed knee.
@@ -153,24 +152,7 @@ def _gait_plan(scene: Scene, gait: Gait) -> tuple[Plan, np.ndarray]:
 
     if gait.running:
         plan.root_pos = _spring_mass_root(scene, plan, travel, bob, limit_of)
-    else:
-        plan.root_pos = _steady_travel_root(scene, plan, travel, limit_of)
     return plan, phase_l
-
-
-def _steady_travel_root(
-    scene: Scene, plan: Plan, travel: np.ndarray, limit_of: Callable[[np.ndarray], np.ndarray]
-) -> np.ndarray:
-    """``(T, 3)`` root positions whose centre of mass travels forward at the constant speed
-    of ``travel (T,)``: the pelvis surges against the swinging leg, so the stance foot is not
-    asked for the swing leg's horizontal force. Heights are the plan's, lowered smoothly where
-    the legs would not reach their feet (the root under ``limit_of(root_xy (T, 2)) (T,)``)."""
-    offset = plan_centre_of_mass(scene, plan)[:, 0] - plan.root_pos[:, 0]
-    wanted = np.full((scene.n_frames, 3), np.nan)
-    wanted[:, 0] = travel + offset.mean()
-    root = follow_centre_of_mass(scene, plan, wanted)
-    root[:, 2] = smooth_cap(root[:, 2], limit_of(root[:, :2]), scene.fps, CAP_HALF_WIDTH_S)
-    return root
 
 
 def _spring_mass_root(
