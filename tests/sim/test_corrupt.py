@@ -11,10 +11,6 @@ from avatar_models.generator import generate
 from sim import corrupt
 from sim.plausibility import check_motion
 
-# The generated run still bends the ankle past its range at toe-off (tests/avatar_models/
-# test_generator_physics.py tracks it); strict, so the fix is noticed.
-GENERATED_RUN_GAP = "generated run exceeds ankle joint limits at toe-off"
-
 DEFECTS = ("penetration", "floating", "joint_limits", "skating", "jitter")
 
 
@@ -41,7 +37,7 @@ def assert_suite(motion):
     "activity",
     [
         "walk",
-        pytest.param("run", marks=pytest.mark.xfail(strict=True, reason=GENERATED_RUN_GAP)),
+        "run",
         "squat",
     ],
 )

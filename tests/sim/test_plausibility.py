@@ -11,16 +11,11 @@ from sim.plausibility import RetargetingNeeded, body_and_motion, check_motion
 KINEMATIC = ("penetration", "floating", "skating", "joint_limits", "self_collision", "jitter")
 
 
-# The generated run still bends the ankle past its range at toe-off (tests/avatar_models/
-# test_generator_physics.py tracks it); strict, so the fix is noticed.
-GENERATED_RUN_GAP = "generated run exceeds ankle joint limits at toe-off"
-
-
 @pytest.mark.parametrize(
     "activity",
     [
         "walk",
-        pytest.param("run", marks=pytest.mark.xfail(strict=True, reason=GENERATED_RUN_GAP)),
+        "run",
         "squat",
         "wave",
         "balance",

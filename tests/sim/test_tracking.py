@@ -109,7 +109,7 @@ def test_bandai_walk_10_s_without_falling(mocap_dir):
     from avatar_models.formats import load_motion
     from sim.retarget import retarget
 
-    walk = retarget(load_motion(mocap_dir / BANDAI_WALK))
+    walk = retarget(load_motion(mocap_dir / BANDAI_WALK), level_feet=True)
     qpos = looped(walk.qpos, walk.motion.fps, 10.0)
     result = track(humanoid_model(build_body(walk.motion.skeleton)), qpos, walk.motion.fps)
     _summary_line("bandai walk", result)
