@@ -18,6 +18,19 @@ from scripts.cli_common import JsonOpt, SeedOpt, console, emit_json, load_motion
 DEVICES = ("fisheye", "kinect-v2", "azure-kinect", "azure-kinect-wfov-binned")
 
 
+def _pair(text: str | None, option: str, default: tuple, kind=float) -> tuple:
+    """``"A,B"`` -> ``(A, B)`` of ``kind``; a clear error for anything else."""
+    from avatar_models.errors import AvatarsimError
+
+    if text is None:
+        return default
+    try:
+        a, b = (kind(v) for v in text.split(","))
+    except ValueError:
+        raise AvatarsimError(f"{option} takes two numbers 'A,B', got {text!r}") from None
+    return a, b
+
+
 def register(app: typer.Typer) -> None:
     @app.command()
     @user_errors
@@ -26,6 +39,12 @@ def register(app: typer.Typer) -> None:
         device: Annotated[str, typer.Option(help=f"One of: {', '.join(DEVICES)}.")] = "fisheye",
         out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out/render"),
         duration_s: Annotated[float, typer.Option(help="Seconds of motion to record.")] = 2.0,
+        fov: Annotated[
+            str | None, typer.Option(help="fisheye: field of view 'H,V' in degrees (150,120).")
+        ] = None,
+        size: Annotated[
+            str | None, typer.Option(help="fisheye: image size 'W,H' in pixels (640,480).")
+        ] = None,
         unit: Annotated[str | None, typer.Option(help="File unit (see `info`).")] = None,
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
@@ -41,9 +60,13 @@ def register(app: typer.Typer) -> None:
         m = m[: max(2, int(round(duration_s * m.fps)) + 1)]
         t0 = time.perf_counter()
         if device == "fisheye":
+            from render_cams.fisheye.model import FisheyeModel
             from render_cams.fisheye.sequence import render_fisheye_sequence
 
-            summary = render_fisheye_sequence(m, out, seed=seed)
+            model = FisheyeModel.from_fov(
+                *_pair(fov, "--fov", (150, 120)), *_pair(size, "--size", (640, 480), int)
+            )
+            summary = render_fisheye_sequence(m, out, seed=seed, model=model)
         else:
             from render_cams.kinect.sequence import render_kinect_sequence
 

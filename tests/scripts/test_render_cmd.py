@@ -47,3 +47,15 @@ def test_unknown_device_and_activity_exit_2(tmp_path):
     assert bad.exit_code == 2 and "unknown device" in bad.stderr
     bad = runner.invoke(app, ["render", "builtin:fly", "--out", str(tmp_path)])
     assert bad.exit_code == 2 and "unknown built-in activity" in bad.stderr
+
+
+def test_impossible_fisheye_intrinsics_exit_2(tmp_path):
+    wide = runner.invoke(
+        app, ["render", "builtin:walk", "--fov", "200,120", "--out", str(tmp_path)]
+    )
+    assert wide.exit_code == 2 and "FOV" in wide.stderr
+    garbled = runner.invoke(
+        app, ["render", "builtin:walk", "--size", "640", "--out", str(tmp_path)]
+    )
+    assert garbled.exit_code == 2 and "--size takes two numbers" in garbled.stderr
+    assert not any(tmp_path.iterdir())  # nothing written for bad input
