@@ -16,18 +16,25 @@ task-space / QP controller of legged robots and physics-based characters, e.g. d
   :attr:`TrackingSettings.contact_margin` of the floor count, so the whole sole is usable):
 
       min  |W (qacc - qacc_des)|² + w_f |J_rot qacc - a_f|² + w_c |J_c qacc + k_c J_c qvel|²
-           + w_lambda |lambda|²
+           + |W_com (J_com qacc - a_com)|² + w_lambda |lambda|²
       s.t. M_root qacc + c_root = (J_cᵀ E lambda)_root        (the 6 unactuated rows)
 
-  so the root's acceleration can come from contact forces only;
+  so the root's acceleration can come from contact forces only; ``a_com = a_ref + Kp (c_ref -
+  c) + Kd (v_ref - v)`` steers the whole-body centre of mass (``mj_jacSubtreeCom``; the
+  reference's from ``subtree_com``, finite-differenced) — the centroidal (linear momentum)
+  task of Wensing & Orin 2013, which only contact forces can satisfy;
 * joint torques ``tau = (M qacc + c - J_cᵀ E lambda)_hinges`` are sent to the actuators,
   switched to motors in the tracking model copy; MuJoCo then simulates the contacts itself.
+  The QP runs every :attr:`TrackingSettings.control_period` simulation steps (100 Hz by
+  default) and its torques are held in between.
 
-Foot placement (Yin et al. 2007, SIMBICON: ``theta_d = theta_0 + c_d d + c_v v``): a leg the
-reference swings has its hip target shifted by ``J_hip⁺ (c_d e + c_v e_dot)``, with ``e``
-the root's horizontal position error (simulated minus reference) and ``J_hip`` the ankle's
-horizontal Jacobian over the hip hinges, so the next stance foot lands where it can pull
-the body back onto the reference (capture-point feedback).
+Foot placement (capture point, Pratt et al. 2006 "Capture point: a step toward humanoid push
+recovery"; SIMBICON's ``c_d d + c_v v`` of Yin et al. 2007 is its linear form): a leg the
+reference swings has its hip target shifted by ``J_hip⁺ (g ⊙ e_xi)``, with ``e_xi`` the
+horizontal error of the capture point ``xi = c + v / omega`` (``omega = sqrt(g / c_z)``;
+simulated minus reference, in world coordinates, gains ``g`` along the reference heading and
+sideways) and ``J_hip`` the ankle's horizontal Jacobian over the hip hinges, so the next
+stance foot lands where it can bring the body back onto the reference.
 
 Nothing acts on the root: no actuator on the free joint, ``xfrc_applied`` and
 ``qfrc_applied`` stay zero (tested).
@@ -55,6 +62,7 @@ QP_SOLVER = "daqp"
 FEET = ("Bip01 L Foot", "Bip01 R Foot")
 THIGHS = ("Bip01 L Thigh", "Bip01 R Thigh")
 ANKLE_SITES = ("l_ankle", "r_ankle")
+GRAVITY = 9.81
 
 
 @dataclass(frozen=True)
@@ -72,11 +80,10 @@ class TrackingSettings:
         friction: cone coefficient of the QP, below the geoms' 1.0 for a margin.
         contact_margin: a foot within this of the floor (m) offers contacts to the QP.
         level_stance_feet: aim a foot the reference stands on flat (see ``_foot_tasks``).
-        step_position_gain, step_velocity_gain: SIMBICON ``c_d`` (m/m), ``c_v`` (s), along the
-            reference's heading and sideways. No forward position gain: the stance leg
-            carries the body by the reference's joint angles, so a foot placed ahead of a
-            body that is ahead makes it further ahead (positive feedback); forward errors
-            are left to the velocity term.
+        com_weight, kp_com, kd_com: centre-of-mass task, per axis (world x, y, z); weight next
+            to a hinge's 1.
+        capture_gain: foot-placement shift per metre of capture-point error (simulated minus
+            reference), along the reference's heading and sideways.
         max_step_shift: bound on the foot-placement shift (m).
         swing_ramp_s: the shift fades in over this time after lift-off.
         stance_height: a reference foot stands while its ankle is within this of its lowest
@@ -103,13 +110,15 @@ class TrackingSettings:
     friction: float = 0.8
     contact_margin: float = 0.005
     level_stance_feet: bool = False
-    step_position_gain: tuple[float, float] = (0.0, 0.5)
-    step_velocity_gain: tuple[float, float] = (0.2, 0.2)
+    com_weight: tuple[float, float, float] = (3.0, 3.0, 3.0)
+    kp_com: float = 20.0
+    kd_com: float = 10.0
+    capture_gain: tuple[float, float] = (0.2, 0.3)
     max_step_shift: float = 0.25
     swing_ramp_s: float = 0.15
     stance_height: float = 0.03
     smoothing_frames: float = 1.0
-    control_period: int = 1
+    control_period: int = 5
     fall_head_ratio: float = 0.6
     fall_tilt_deg: float = 60.0
 
@@ -280,6 +289,7 @@ class Tracker:
         self.sole_normal = [rest.xmat[b].reshape(3, 3)[2] for b in self.feet]  # R^T z
         mu = s.friction
         # Friction-pyramid edges on the floor, world axes (x, y, z) by edge.
+        self._jac_com = np.zeros((3, nv))
         self.edges = np.array([[mu, 0, 1], [-mu, 0, 1], [0, mu, 1], [0, -mu, 1]], float).T
 
     def swing_weights(self, qpos: np.ndarray, fps: float) -> np.ndarray:
@@ -292,6 +302,17 @@ class Tracker:
             since[t] = np.where(swing[t], since[t - 1] + 1.0 / fps, 0.0)
         ramp = max(self.settings.swing_ramp_s, 1e-9)
         return np.where(swing, np.clip(since / ramp, 1.0 / (ramp * fps), 1.0), 0.0)
+
+    def reference_com(self, qpos: np.ndarray) -> np.ndarray:
+        """``(T, 3)`` whole-body centre of mass of ``qpos (T, nq)``."""
+        data = mujoco.MjData(self.model)
+        out = np.empty((qpos.shape[0], 3))
+        for t in range(qpos.shape[0]):  # MuJoCo evaluates one state per call
+            data.qpos[:] = qpos[t]
+            mujoco.mj_kinematics(self.model, data)
+            mujoco.mj_comPos(self.model, data)
+            out[t] = data.subtree_com[0]
+        return out
 
     def reference_sites(self, qpos: np.ndarray) -> np.ndarray:
         """``(T, 17, 3)`` body17 site positions of ``qpos (T, nq)`` (kinematics only)."""
@@ -308,7 +329,7 @@ class Tracker:
 
     def run(self, qpos_ref: np.ndarray, fps: float) -> TrackingResult:
         """Track ``qpos_ref (T, nq)`` sampled at ``fps`` from its first frame and velocity.
-        The reference is interpolated at every simulation step (on the manifold)."""
+        The reference is interpolated at every control update (on the manifold)."""
         qpos_ref = np.asarray(qpos_ref, dtype=float)
         m, d, s = self.model, self.data, self.settings
         if qpos_ref.ndim != 2 or qpos_ref.shape[1] != m.nq or not np.isfinite(qpos_ref).all():
@@ -326,6 +347,9 @@ class Tracker:
             qacc_ref = gaussian_filter1d(qacc_ref, sigma, axis=0, mode="nearest")
         swing = self.swing_weights(qpos_ref, fps)
         ref_sites = self.reference_sites(qpos_ref)
+        com_ref = self.reference_com(qpos_ref)
+        com_vel_ref = gaussian_filter1d(np.gradient(com_ref, 1.0 / fps, axis=0), 1.0, axis=0)
+        com_acc_ref = gaussian_filter1d(np.gradient(com_vel_ref, 1.0 / fps, axis=0), 1.0, axis=0)
 
         mujoco.mj_resetData(m, d)
         d.qpos[:], d.qvel[:] = qpos_ref[0], qvel_ref[0]
@@ -350,9 +374,11 @@ class Tracker:
                 v_target = (1 - a) * qvel_ref[i] + a * qvel_ref[i + 1]
                 a_target = (1 - a) * qacc_ref[i] + a * qacc_ref[i + 1]
                 swinging = (1 - a) * swing[i] + a * swing[i + 1]
-                self._place_feet(q_target, v_target, swinging)
+                com = [(1 - a) * r[i] + a * r[i + 1] for r in (com_ref, com_vel_ref, com_acc_ref)]
+                self._com_jacobian()
+                self._place_feet(q_target, self._step_shift(q_target, com), swinging)
                 standing = (swinging == 0) & s.level_stance_feet
-                tau = self._torques(q_target, v_target, a_target, standing)
+                tau = self._torques(q_target, v_target, a_target, com, standing)
             d.ctrl[:] = tau
             mujoco.mj_step2(m, d)
             mujoco.mj_step1(m, d)
@@ -370,26 +396,39 @@ class Tracker:
             fps=fps,
         )
 
-    def _place_feet(self, q_target: np.ndarray, v_target: np.ndarray, swing: np.ndarray):
-        """Shift the swinging hips' targets in ``q_target`` (in place); module docstring."""
+    def _com_jacobian(self):
+        """``(3, nv)`` Jacobian of the whole-body centre of mass in the current state."""
+        mujoco.mj_jacSubtreeCom(self.model, self.data, self._jac_com, 0)
+
+    def _step_shift(self, q_target: np.ndarray, com: list[np.ndarray]) -> np.ndarray:
+        """``(3,)`` world shift of a swinging foot's target: the capture-point error
+        (simulated minus reference, horizontal) times :attr:`TrackingSettings.capture_gain`,
+        bounded by ``max_step_shift``. ``com``: reference centre of mass position, velocity,
+        acceleration ``(3,)`` each."""
         s, d = self.settings, self.data
         yaw = _yaw(q_target[3:7])
         heading = np.array([[np.cos(yaw), np.sin(yaw)], [-np.sin(yaw), np.cos(yaw)]])
-        error = heading @ (d.qpos[:2] - q_target[:2])  # (forward, left)
-        rate = heading @ (d.qvel[:2] - v_target[:2])
-        gains = np.asarray(s.step_position_gain), np.asarray(s.step_velocity_gain)
-        shift = heading.T @ (gains[0] * error + gains[1] * rate)
+        omega = np.sqrt(GRAVITY / com[0][2])
+        capture = d.subtree_com[0, :2] + (self._jac_com @ d.qvel)[:2] / omega
+        error = heading @ (capture - com[0][:2] - com[1][:2] / omega)  # (forward, left)
+        shift = heading.T @ (np.asarray(s.capture_gain) * error)
         norm = np.linalg.norm(shift)
         if norm > s.max_step_shift:
             shift *= s.max_step_shift / norm
+        return shift
+
+    def _place_feet(self, q_target: np.ndarray, shift: np.ndarray, swing: np.ndarray):
+        """Shift the swinging hips' targets in ``q_target`` (in place) so that the ankles
+        move by ``swing (2,) x shift (2,)`` (world, horizontal): ``J_hip⁺ shift`` with the
+        ankle's horizontal Jacobian over the hip hinges (damped pseudo-inverse)."""
         jac = np.zeros((3, self.model.nv))
         for side in np.flatnonzero(swing > 0):
-            mujoco.mj_jacSite(self.model, d, jac, None, self.ankles[side])
+            mujoco.mj_jacSite(self.model, self.data, jac, None, self.ankles[side])
             j = jac[:2, self.hip_dof[side]]
-            dq = j.T @ np.linalg.solve(j @ j.T + 1e-4 * np.eye(2), shift)  # damped pseudo-inverse
+            dq = j.T @ np.linalg.solve(j @ j.T + 1e-4 * np.eye(2), shift)
             q_target[self.hip_qadr[side]] += swing[side] * dq
 
-    def _torques(self, q_target, v_target, a_target, standing) -> np.ndarray:
+    def _torques(self, q_target, v_target, a_target, com, standing) -> np.ndarray:
         """``(nu,)`` hinge torques of the whole-body QP (module docstring)."""
         m, d, s = self.model, self.data, self.settings
         nv = m.nv
@@ -408,6 +447,12 @@ class Tracker:
         for jr, acc in self._foot_tasks(q_target, v_target, standing):
             hess[:nv, :nv] += s.foot_weight * jr.T @ jr
             grad[:nv] -= s.foot_weight * jr.T @ acc
+        jcom, wcom = self._jac_com, np.asarray(s.com_weight)[:, None]
+        com_acc = (
+            com[2] + s.kp_com * (com[0] - d.subtree_com[0]) + s.kd_com * (com[1] - jcom @ d.qvel)
+        )
+        hess[:nv, :nv] += jcom.T @ (wcom * jcom)
+        grad[:nv] -= jcom.T @ (wcom[:, 0] * com_acc)
         if je.shape[1]:
             hess[:nv, :nv] += s.contact_weight * jc.T @ jc
             grad[:nv] += s.contact_weight * jc.T @ (s.contact_damping * (jc @ d.qvel))
