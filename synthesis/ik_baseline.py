@@ -8,12 +8,19 @@ steps under the moving body. Ours does the same on the MuJoCo humanoid of
 - targets of the head and wrist sites: the device poses with the nominal device attachments
   (:func:`render_cams.vr.nominal_attachment`) taken off, i.e. where the joints must be for a
   user calibrated to the rig (VRIK is calibrated the same way), position and orientation;
-- a pelvis hint below the head: the rest head-to-pelvis offset turned by the head's heading,
-  so the spine bends only as much as the head and hands need;
+- a pelvis hint below the head (:meth:`IKBaseline.body_targets`): the rest body hung from
+  the head, turned to the face's heading and leaned forward once the head pitches past a
+  dead zone (a face-down swimmer lies horizontal); a lowered head crouches the legs;
 - feet from a procedural stepper (:class:`Stepper`): each foot stays planted until the
   neutral stance under the pelvis hint (raised with a climbing head) has moved away from it
-  by more than :data:`STEP_TRIGGER_M`, then steps there in :data:`STEP_DURATION_S` on a
-  raised arc, one foot at a time, as VRIK's locomotion does.
+  by more than :data:`STEP_TRIGGER_M`, then steps to where the stance will be, half a step
+  ahead, one foot at a time, as VRIK's locomotion does; cadence and swing height grow with
+  the body's speed. A body leaning past :data:`GROUNDED_LEAN_RAD` does not stand: its feet
+  move with it;
+- soft targets kept consistent with the tracked ones: feet within a leg of the pelvis hint,
+  hands within an arm (plus :data:`ARM_REACH_SLACK_M`) of the shoulders. The QP's costs are
+  squared, so one far soft target (a foot left behind by a running body) outweighed the
+  head's and hands' centimetres and held them 4 cm off on a noise-free run.
 
 Each tick is one warm-started IK solve of a few QP iterations (VRIK also iterates once or
 twice per frame and relies on temporal coherence). Missing devices hold their last pose;
@@ -25,6 +32,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import mujoco
 import numpy as np
 from threadpoolctl import threadpool_limits
 
@@ -43,48 +51,104 @@ DEVICE_SITES = {"hmd": "head", "left_controller": "l_wrist", "right_controller":
 POSITION_COST = np.array([10.0, 1.0, 1.0, 0.05, 0.05, 0.05])
 """Tracked joints dominate, the head most (VRIK locks the head: an out-of-reach hand must not
 drag the body along); the pelvis hint and the stepper's feet are soft (VRIK's body and
-leg weights are likewise below the head and hand weights)."""
+leg weights are likewise below the head and hand weights). Soft targets are kept within
+reach of each other (:meth:`IKBaseline.body_targets`): the costs are squared, so a foot
+left half a metre behind a running body would outweigh centimetres of head error."""
 ORIENTATION_COST = np.array([0.1, 0.01, 0.01, 0.0, 0.0, 0.0])
 """Head and hand orientation follow their devices far more loosely than their positions
 (mink weighs 1 rad like 1 m): stronger hand weights trap the QP in poses centimetres off
 the hand positions when a controller is turned far from the rest forearm."""
 
+ARM_REACH_SLACK_M = 0.15
+"""Reach beyond the straight arm that a hand target may ask for (our choice: what a trunk
+lean and the shoulder girdle add, about a hand's length); farther targets are pulled in."""
+LEAN_DEAD_ZONE_RAD = np.radians(30.0)
+LEAN_FULL_RAD = np.radians(75.0)
+"""Trunk lean from the head's pitch (our choice, in the spirit of VRIK's body tilt): a head
+pitched less than the dead zone (looking down at a ball or a hand) leaves the trunk upright;
+beyond it the trunk leans, reaching horizontal at :data:`LEAN_FULL_RAD` (a face-down head,
+as when lying or swimming)."""
+GROUNDED_LEAN_RAD = np.radians(60.0)
+"""A trunk leaning further than this does not stand on its feet (lying, swimming, crawling):
+the feet then stay in their stance relative to the body instead of planting on the floor."""
 STEP_TRIGGER_M = 0.12
 """Distance between a planted foot and its neutral stance that starts a step
 (VRIK's default ``stepThreshold`` is 0.4 m of body motion split over two feet; a smaller
 value keeps the feet under a walking body)."""
-STEP_DURATION_S = 0.25
-"""Duration of one procedural step (VRIK's default ``stepSpeed`` of 3 steps per second)."""
-STEP_HEIGHT_M = 0.05
-"""Apex of the foot's arc above the floor level during a step."""
+CADENCE_STEPS_PER_S = (1.1, 0.55)
+"""Step frequency ``a + b v`` (steps/s) at horizontal speed ``v`` (m/s): about 1.8 steps/s
+walking at 1.3 m/s and 2.9 steps/s running at 3.3 m/s (Dean 1965; Cavanagh & Kram 1989
+report 2.7-3.0 steps/s at 3-4 m/s)."""
+MAX_SWING_S = 0.4
+"""Longest swing of one foot: a step takes ``min(1 / cadence, MAX_SWING_S)``. Swing time
+varies little with walking speed (about 40 % of a 1 s stride); standing steps are as quick."""
+STEP_HEIGHT_M = (0.05, 0.1, 0.35)
+"""Apex of the foot's arc above its planted height: ``clip(b v, lo, hi)`` as ``(lo, b, hi)``
+(our choice: about 0.13 m walking, 0.33 m running, the swing-foot heights of typical gait)."""
 ITERATIONS_PER_TICK = 4
 """QP iterations per 90 Hz tick after the first (warm start; enough to stay within 1 cm of
 reachable targets at VR motion speeds, measured on the generator's activities)."""
+
+
+VELOCITY_SMOOTHING_S = 0.1
+"""Time constant of the body velocity that sizes the steps (our choice: a tenth of a step)."""
+
+_X, _Y, _Z = np.eye(3)
+
+
+def trunk_lean(head_pitch: float) -> float:
+    """Forward trunk lean (radians, 0 upright, pi/2 horizontal) for a head pitched forward by
+    ``head_pitch`` radians (:data:`LEAN_DEAD_ZONE_RAD`, :data:`LEAN_FULL_RAD`)."""
+    share = (head_pitch - LEAN_DEAD_ZONE_RAD) / (LEAN_FULL_RAD - LEAN_DEAD_ZONE_RAD)
+    return 0.5 * np.pi * float(np.clip(share, 0.0, 1.0))
+
+
+def _clip_norm(v: np.ndarray, limit: np.ndarray) -> np.ndarray:
+    """Rows of ``v (N, 3)`` shortened to at most ``limit (N, 1)``."""
+    norm = np.linalg.norm(v, axis=-1, keepdims=True)
+    return v * np.minimum(1.0, limit / np.maximum(norm, 1e-12))
+
+
+def cadence(speed: float) -> float:
+    """Steps per second at horizontal ``speed`` m/s (:data:`CADENCE_STEPS_PER_S`)."""
+    return CADENCE_STEPS_PER_S[0] + CADENCE_STEPS_PER_S[1] * speed
 
 
 @dataclass
 class Stepper:
     """Procedural feet: planted until the neutral stance moves away, then one step there.
 
-    State per foot: ``planted (2, 3)`` position on the floor, and the step in progress
-    (start, goal, elapsed time) of at most one foot.
+    Step duration and swing height follow the body's speed (:func:`cadence`,
+    :data:`STEP_HEIGHT_M`); one foot swings at a time, so a moving body alternates its feet.
+    State per foot: ``planted (2, 3)`` position, and the step in progress (start, goal,
+    duration, elapsed time, apex) of at most one foot.
     """
 
     planted: np.ndarray
     stepping: int = -1
     start: np.ndarray | None = None
     goal: np.ndarray | None = None
+    duration: float = 1.0
+    apex: float = 0.0
     elapsed: float = 0.0
 
-    def advance(self, neutral: np.ndarray, velocity: np.ndarray, dt: float) -> np.ndarray:
+    def advance(
+        self, neutral: np.ndarray, velocity: np.ndarray, dt: float, grounded: bool = True
+    ) -> np.ndarray:
         """Feet positions ``(2, 3)`` after ``dt`` seconds, given the neutral stance ``(2, 3)``
-        and the body's horizontal velocity ``(3,)`` (a step lands where the body will be)."""
+        and the body's horizontal velocity ``(3,)``. A step lands where the stance will be
+        when it lands, plus half a step: the body then passes over the planted foot while
+        the other swings, from half a step ahead to half a step behind. Feet that are not
+        ``grounded`` (a body lying or floating) move with the body, in their stance."""
+        if not grounded:
+            self.planted, self.stepping = neutral.copy(), -1
+            return self.planted.copy()
         if self.stepping >= 0:
             self.elapsed += dt
-            s = min(self.elapsed / STEP_DURATION_S, 1.0)
+            s = min(self.elapsed / self.duration, 1.0)
             blend = s * s * (3.0 - 2.0 * s)  # smoothstep: zero speed at lift-off and landing
             foot = self.start + blend * (self.goal - self.start)
-            foot[2] += STEP_HEIGHT_M * np.sin(np.pi * s)
+            foot[2] += self.apex * np.sin(np.pi * s)
             self.planted[self.stepping] = foot
             if s >= 1.0:
                 self.planted[self.stepping] = self.goal
@@ -93,9 +157,13 @@ class Stepper:
             gap = np.linalg.norm(neutral - self.planted, axis=1)
             foot = int(np.argmax(gap))
             if gap[foot] > STEP_TRIGGER_M:
+                speed = float(np.linalg.norm(velocity[:2]))
+                lo, gain, hi = STEP_HEIGHT_M
                 self.stepping, self.elapsed = foot, 0.0
+                self.duration = min(1.0 / cadence(speed), MAX_SWING_S)
+                self.apex = float(np.clip(gain * speed, lo, hi))
                 self.start = self.planted[foot].copy()
-                self.goal = neutral[foot] + 0.5 * STEP_DURATION_S * velocity
+                self.goal = neutral[foot] + 1.5 * self.duration * velocity
         return self.planted.copy()
 
 
@@ -146,6 +214,22 @@ class IKBaseline(Synthesizer):
         rest = self.ik.frame_positions(self.ik.posture)
         self._rest_head_to_pelvis = rest[3] - rest[0]
         self._rest_pelvis_to_feet = rest[4:] - rest[3]
+        self._leg_reach = np.linalg.norm(self._rest_pelvis_to_feet, axis=1)[:, None]
+        sites = self.ik.configuration.data.site_xpos  # every body17 site, at the rest posture
+        site = {
+            n: sites[mujoco.mj_name2id(self.ik.model, mujoco.mjtObj.mjOBJ_SITE, n)].copy()
+            for n in ("l_shoulder", "l_elbow", "l_wrist", "r_shoulder", "r_elbow", "r_wrist")
+        }
+        self._rest_head_to_shoulders = np.stack([site["l_shoulder"], site["r_shoulder"]]) - rest[0]
+        self._arm_reach = ARM_REACH_SLACK_M + np.array(
+            [
+                [
+                    np.linalg.norm(site[f"{s}_elbow"] - site[f"{s}_shoulder"])
+                    + np.linalg.norm(site[f"{s}_wrist"] - site[f"{s}_elbow"])
+                ]
+                for s in "lr"
+            ]
+        )
         self._rest_sites = rest
         self.reset()
 
@@ -160,6 +244,7 @@ class IKBaseline(Synthesizer):
         self._stepper: Stepper | None = None
         self._last_time: float | None = None
         self._last_pelvis: np.ndarray | None = None
+        self._velocity = np.zeros(3)
 
     def _device_index(self, names: tuple[str, ...]) -> np.ndarray:
         missing = [d for d in HEADSET_AND_CONTROLLERS if d not in names]
@@ -175,6 +260,34 @@ class IKBaseline(Synthesizer):
         att_rot = np.stack([a.rotation for a in self._attachments])
         rot = quat.normalize(quat.mul(quat.normalize(quaternions), quat.conj(att_rot)))
         return np.concatenate([positions - quat.rotate(rot, att_pos), rot], axis=1)
+
+    def body_targets(self, head_pos: np.ndarray, head_rot: np.ndarray):
+        """Pelvis hint ``(3,)``, neutral stance of the feet ``(2, 3)``, whether the body
+        stands on them (trunk lean below :data:`GROUNDED_LEAN_RAD`) and the body's turn
+        from its rest pose (wxyz), under a head at
+        ``head_pos (3,)`` turned by ``head_rot`` (wxyz, the head joint's global rotation).
+
+        The rest body hangs from the head, turned to the head's heading and leaned forward
+        by :func:`trunk_lean`; the feet continue the trunk line (legs straight below an
+        upright pelvis, trailing behind a horizontal one) but never below the floor: a
+        lowered head bends the knees (crouch), a raised one lifts the feet (a rung, a step).
+        """
+        fwd = quat.rotate(head_rot, _X)
+        up = quat.rotate(head_rot, _Z)
+        # Heading: the face's forward axis for an upright head, its up axis for a face-down
+        # one (whose forward axis is vertical, and turns sideways when a swimmer breathes).
+        upright = abs(float(up[2]))
+        facing = upright * fwd[:2] + (1.0 - upright) * up[:2]
+        heading = float(np.arctan2(facing[1], facing[0]))
+        forward_tilt = float(np.arccos(np.clip(up[2], -1.0, 1.0)))
+        if np.dot(up[:2], facing) < 0:  # head tilted back (looking up): the trunk stays upright
+            forward_tilt = 0.0
+        lean = trunk_lean(forward_tilt)
+        body = quat.mul(quat.from_axis_angle(_Z, heading), quat.from_axis_angle(_Y, lean))
+        pelvis = head_pos + quat.rotate(body, self._rest_head_to_pelvis)
+        neutral = pelvis + quat.rotate(body, self._rest_pelvis_to_feet)
+        neutral[:, 2] = np.maximum(neutral[:, 2], self._rest_sites[4:, 2])
+        return pelvis, neutral, lean < GROUNDED_LEAN_RAD, body
 
     def _solve(self, frame: TrackingFrame) -> np.ndarray:
         """The qpos ``(nq,)`` for one tracking sample (state advanced)."""
@@ -196,22 +309,26 @@ class IKBaseline(Synthesizer):
                 return self._q  # nothing to stand under yet: rest pose
             self._joints = np.where(ok[:, None], fresh, np.nan)
         self._joints = np.where(ok[:, None], fresh, self._joints)
-        head_pos, head_rot = self._joints[0, :3], self._joints[0, 3:]
-        heading = quat.from_axis_angle(np.array([0.0, 0.0, 1.0]), quat.yaw(head_rot))
-        pelvis = head_pos + quat.rotate(heading, self._rest_head_to_pelvis)
-        neutral = pelvis + quat.rotate(heading, self._rest_pelvis_to_feet)
-        # The feet stand on the floor, or on whatever raises a head above its standing
-        # height (a ladder rung, a step): a crouch bends the knees, a climb lifts the feet.
-        support = max(0.0, head_pos[2] - self._rest_sites[0, 2])
-        neutral[:, 2] = self._rest_sites[4:, 2] + support
-        velocity = np.zeros(3)
+        pelvis, neutral, grounded, body = self.body_targets(
+            self._joints[0, :3], self._joints[0, 3:]
+        )
         if self._last_pelvis is not None and dt > 0:
-            velocity[:2] = (pelvis - self._last_pelvis)[:2] / dt
+            # Smoothed over VELOCITY_SMOOTHING_S: the step goals must not jitter with the head.
+            alpha = min(1.0, dt / VELOCITY_SMOOTHING_S)
+            moved = np.array([*((pelvis - self._last_pelvis)[:2] / dt), 0.0])
+            self._velocity += alpha * (moved - self._velocity)
         self._last_pelvis = pelvis
         if self._stepper is None:
             self._stepper = Stepper(neutral.copy())
-        feet = self._stepper.advance(neutral, velocity, dt)
-        positions = np.concatenate([self._joints[:, :3], pelvis[None], feet])
+        feet = self._stepper.advance(neutral, self._velocity, dt, grounded)
+        # A planted foot the body has run away from stays where it is in the stepper, but its
+        # target comes no farther from the pelvis than the straight leg (reachable: no fight).
+        reach = pelvis + _clip_norm(feet - pelvis, self._leg_reach)
+        # Hands no farther from their shoulders than the arm (plus the trunk's lean): an
+        # out-of-reach controller is reached straight at, without dragging the head along.
+        shoulders = self._joints[0, :3] + quat.rotate(body, self._rest_head_to_shoulders)
+        hands = shoulders + _clip_norm(self._joints[1:, :3] - shoulders, self._arm_reach)
+        positions = np.concatenate([self._joints[:1, :3], hands, pelvis[None], reach])
         orientations = np.tile(quat.IDENTITY, (len(STEERED_SITES), 1))
         orientations[:3] = self._joints[:, 3:]
         # Hands never seen yet: no target (NaN rows are dropped by the solver).

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import body17
+from avatar_models import body17, quat
 from avatar_models.generator import Subject, generate
 from avatar_models.measure import standing_height
 from avatar_models.rigs import body17_positions
@@ -105,6 +105,32 @@ def test_stepper_steps_once_the_stance_moves_away():
     stepper = Stepper(feet.copy())
     assert np.allclose(stepper.advance(feet, np.zeros(3), 1 / 90), feet)  # standing still
     moved = feet + np.array([0.3, 0.0, 0.0])
-    for _ in range(60):  # 0.67 s: time for both feet to step
+    for _ in range(80):  # 0.89 s: time for both feet to step (0.4 s each)
         out = stepper.advance(moved, np.zeros(3), 1 / 90)
     assert np.allclose(out, moved)
+
+
+@pytest.mark.parametrize("activity", ["run", "swim"])
+def test_tracked_joints_stay_on_noise_free_targets_while_the_body_moves(activity):
+    """Nominal attachments, noise-free devices: head and hands lie on their targets even while
+    the soft body hints (a running body's feet, a swimmer's trailing legs) pull elsewhere."""
+    motion = generate(activity, Subject(height_m=1.75), 1.5, 90.0, seed=3)
+    out = IKBaseline(motion.skeleton, standing_height(motion)).run(VRSetup().sample(motion))
+    err = np.linalg.norm(
+        body17_positions(out)[:, TRACKED] - body17_positions(motion)[:, TRACKED], axis=-1
+    )
+    assert np.median(err) < 0.01
+    assert np.percentile(err, 95) < 0.02
+
+
+def test_face_down_head_lays_the_body_behind_it(dribble):
+    """A head pitched face-down (as a swimmer's) leans the trunk to horizontal: the pelvis
+    hint lies behind the head at its height, the feet trail at the same height."""
+    motion, _ = dribble
+    ik = IKBaseline(motion.skeleton)
+    face_down = quat.from_axis_angle(np.array([0.0, 1.0, 0.0]), np.pi / 2)  # +X turned to -Z
+    head = np.array([0.0, 0.0, 0.9])
+    pelvis, feet, grounded, _ = ik.body_targets(head, face_down)
+    assert not grounded
+    assert pelvis[0] < -0.4 and abs(pelvis[2] - head[2]) < 0.1
+    assert np.all(feet[:, 0] < pelvis[0] - 0.6) and np.all(np.abs(feet[:, 2] - head[2]) < 0.15)
