@@ -10,6 +10,8 @@ cross-subject split (see ``synthesis.coolmoves.accuracy``).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -49,3 +51,81 @@ class KNNMatcher:
         dist = np.asarray(dist, float).reshape(len(queries), self.k)
         idx = np.asarray(idx).reshape(len(queries), self.k)
         return dist, np.where(np.isfinite(dist), idx, -1), inverse_distance_weights(dist)
+
+
+class BothHandsKNN:
+    """Both hands' :class:`KNNMatcher` searches in one KD-tree, so that one sample costs one
+    query call (the per-call set-up of ``cKDTree.query`` is most of a single query's time).
+
+    The sides' vectors get one extra coordinate, 0 for the left hand and ``separation`` for
+    the right, larger than the distance threshold: a query carrying its side's coordinate
+    never finds the other side's windows within the threshold, and its distances to its own
+    side are those of the side's own tree (the extra term is exactly 0).
+
+    Args:
+        vectors: per side (left, right) ``(N_s, F)`` search vectors of the database windows.
+    """
+
+    def __init__(
+        self,
+        vectors: Sequence[np.ndarray],
+        k: int = K_NEIGHBOURS,
+        max_distance: float = MAX_DISTANCE,
+    ):
+        self.k = int(min(k, *(len(v) for v in vectors)))
+        self.max_distance = float(max_distance)
+        self._side_coord = np.array([0.0, 2.0 * self.max_distance + 1.0])
+        self._first = np.cumsum([0] + [len(v) for v in vectors[:-1]])  # (2,) index offsets
+        points = np.concatenate(
+            [
+                np.column_stack([np.asarray(v, float), np.full(len(v), c)])
+                for v, c in zip(vectors, self._side_coord, strict=True)
+            ]
+        )
+        self.tree = cKDTree(points, balanced_tree=False)  # see KNNMatcher on the splits
+
+    def query(
+        self, queries: np.ndarray, tracked: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Distances, per-side indices and weights ``(2, B, k)`` for ``queries (B, 2, F)``
+        (left, right); sides not ``tracked (B, 2)`` get no matches (``inf``, -1, 0)."""
+        b = queries.shape[0]
+        points = np.empty((b, 2, queries.shape[-1] + 1))
+        points[..., :-1] = np.where(tracked[..., None], queries, 0.0)  # NaN-free
+        points[..., -1] = self._side_coord
+        dist, idx = self.tree.query(
+            points.reshape(2 * b, -1),
+            k=self.k,
+            distance_upper_bound=self.max_distance,
+            workers=1,
+        )
+        dist = np.where(tracked.reshape(2 * b, 1), dist, np.inf).reshape(b, 2, self.k)
+        idx = np.asarray(idx).reshape(b, 2, self.k) - self._first[:, None]
+        dist = dist.transpose(1, 0, 2)
+        idx = np.where(np.isfinite(dist), idx.transpose(1, 0, 2), -1)
+        return dist, idx, inverse_distance_weights(dist)
+
+
+class PerHand:
+    """One matcher per side behind :class:`BothHandsKNN`'s interface (for matchers, like the
+    mixture variant's, that cannot share one search structure)."""
+
+    def __init__(self, matchers: Sequence):
+        self.matchers = list(matchers)
+        self.k = self.matchers[0].k
+
+    def query(
+        self, queries: np.ndarray, tracked: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """As :meth:`BothHandsKNN.query`."""
+        b = queries.shape[0]
+        dist = np.full((2, b, self.k), np.inf)
+        idx = np.full((2, b, self.k), -1)
+        weights = np.zeros((2, b, self.k))
+        for side, matcher in enumerate(self.matchers):
+            rows = np.flatnonzero(tracked[:, side])
+            if rows.size:
+                dist[side, rows], idx[side, rows], weights[side, rows] = matcher.query(
+                    queries[rows, side]
+                )
+        return dist, idx, weights

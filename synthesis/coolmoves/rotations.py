@@ -13,6 +13,8 @@ wxyz.
 
 from __future__ import annotations
 
+from functools import cache
+
 import numpy as np
 
 from avatar_models import quat
@@ -20,26 +22,44 @@ from avatar_models import quat
 _AXES = {"X": 0, "Y": 1, "Z": 2}
 
 
+def _quadratic_forms() -> np.ndarray:
+    """``(16, 9)`` map from the outer product ``q q^T`` (flattened) of a unit wxyz quaternion
+    to its rotation matrix (flattened, row-major): every entry is a quadratic form in ``q``,
+    e.g. ``R00 = w^2 + x^2 - y^2 - z^2`` (the homogeneous form of ``1 - 2 (y^2 + z^2)``)."""
+    forms = np.zeros((4, 4, 3, 3))
+    w, x, y, z = range(4)
+    for i, j, sign in ((w, w, 1), (x, x, 1), (y, y, -1), (z, z, -1)):
+        forms[i, j, 0, 0] = sign
+    for i, j, sign in ((w, w, 1), (x, x, -1), (y, y, 1), (z, z, -1)):
+        forms[i, j, 1, 1] = sign
+    for i, j, sign in ((w, w, 1), (x, x, -1), (y, y, -1), (z, z, 1)):
+        forms[i, j, 2, 2] = sign
+    # Off-diagonal entries 2 (a b +- c d), split over the symmetric pair (a, b), (b, a).
+    for (r, c), terms in {
+        (0, 1): ((x, y, 1), (w, z, -1)),
+        (0, 2): ((x, z, 1), (w, y, 1)),
+        (1, 0): ((x, y, 1), (w, z, 1)),
+        (1, 2): ((y, z, 1), (w, x, -1)),
+        (2, 0): ((x, z, 1), (w, y, -1)),
+        (2, 1): ((y, z, 1), (w, x, 1)),
+    }.items():
+        for i, j, sign in terms:
+            forms[i, j, r, c] += sign
+            forms[j, i, r, c] += sign
+    return forms.reshape(16, 9)
+
+
+_FORMS = _quadratic_forms()
+
+
 def to_matrix(q: np.ndarray) -> np.ndarray:
-    """Unit quaternions ``(..., 4)`` wxyz -> rotation matrices ``(..., 3, 3)``."""
-    w, x, y, z = np.moveaxis(np.asarray(q, float), -1, 0)
-    xx, yy, zz = x * x, y * y, z * z
-    xy, xz, yz, wx, wy, wz = x * y, x * z, y * z, w * x, w * y, w * z
-    m = np.stack(
-        [
-            1 - 2 * (yy + zz),
-            2 * (xy - wz),
-            2 * (xz + wy),
-            2 * (xy + wz),
-            1 - 2 * (xx + zz),
-            2 * (yz - wx),
-            2 * (xz - wy),
-            2 * (yz + wx),
-            1 - 2 * (xx + yy),
-        ],
-        axis=-1,
-    )
-    return m.reshape(*m.shape[:-1], 3, 3)
+    """Unit quaternions ``(..., 4)`` wxyz -> rotation matrices ``(..., 3, 3)``.
+
+    One outer product and one matrix product (:func:`_quadratic_forms`): a handful of numpy
+    calls whatever the batch shape, where the entry-by-entry formula takes about thirty."""
+    q = np.asarray(q, float)
+    outer = (q[..., :, None] * q[..., None, :]).reshape(*q.shape[:-1], 16)
+    return (outer @ _FORMS).reshape(*q.shape[:-1], 3, 3)
 
 
 def euler_axes(orders: str | list[str]) -> np.ndarray:
@@ -51,6 +71,38 @@ def euler_axes(orders: str | list[str]) -> np.ndarray:
     return axes
 
 
+@cache
+def _euler_forms(axes: tuple[tuple[int, int, int], ...]) -> np.ndarray:
+    """``(G, 16, 5)`` quadratic forms (:func:`_quadratic_forms`) of ``e R[i,k]``,
+    ``-e R[j,k]``, ``R[k,k]``, ``-e R[i,j]``, ``R[i,i]`` per order: what :func:`to_euler`
+    needs of each joint's matrix, signs included."""
+    i, j, k = np.array(axes).T
+    e = np.where((j - i) % 3 == 1, 1.0, -1.0)
+    rows, cols = np.stack([i, j, k, i, i]), np.stack([k, k, k, j, i])  # (5, G)
+    forms = _FORMS.reshape(16, 3, 3)[:, rows, cols] * np.stack([e, -e, 1 + 0 * e, -e, 1 + 0 * e])
+    return np.ascontiguousarray(forms.transpose(2, 0, 1))
+
+
+@cache
+def _euler_products(axes: tuple[tuple[int, int, int], ...]) -> np.ndarray:
+    """``(G, 8, 4)`` map from the eight products ``(cos|sin a/2)(cos|sin b/2)(cos|sin c/2)``
+    (sine bits ``abc`` in binary, ``a`` most significant) to the wxyz quaternion
+    ``q_i(a) q_j(b) q_k(c)``: each product of basis elements is one signed basis element."""
+    basis = np.eye(4)
+    out = np.zeros((len(axes), 8, 4))
+    for g, order in enumerate(axes):
+        for bits in range(8):
+            parts = [
+                basis[1 + ax] if bits >> (2 - n) & 1 else basis[0] for n, ax in enumerate(order)
+            ]
+            out[g, bits] = quat.mul(quat.mul(parts[0], parts[1]), parts[2])
+    return out
+
+
+def _key(axes: np.ndarray) -> tuple[tuple[int, int, int], ...]:
+    return tuple(map(tuple, np.asarray(axes).tolist()))
+
+
 def to_euler(q: np.ndarray, axes: np.ndarray) -> np.ndarray:
     """``(..., G, 4)`` wxyz -> ``(..., G, 3)`` intrinsic Euler angles about ``axes (G|1, 3)``.
 
@@ -58,23 +110,19 @@ def to_euler(q: np.ndarray, axes: np.ndarray) -> np.ndarray:
     ``sin b = e R[i, k]``, ``a = atan2(-e R[j, k], R[k, k])``, ``c = atan2(-e R[i, j], R[i, i])``
     (at ``|b| = pi / 2`` only ``a + e c`` is defined; the split then follows rounding).
     """
-    i, j, k = np.asarray(axes).T
-    e = np.where((j - i) % 3 == 1, 1.0, -1.0)
-    m = to_matrix(q)
-    g = np.arange(m.shape[-3])
-    b = np.arcsin(np.clip(e * m[..., g, i, k], -1.0, 1.0))
-    a = np.arctan2(-e * m[..., g, j, k], m[..., g, k, k])
-    c = np.arctan2(-e * m[..., g, i, j], m[..., g, i, i])
-    return np.stack([a, b, c], axis=-1)
+    q = np.asarray(q, float)
+    outer = (q[..., :, None] * q[..., None, :]).reshape(*q.shape[:-1], 1, 16)
+    entries = (outer @ _euler_forms(_key(axes)))[..., 0, :]  # (..., G, 5)
+    b = np.arcsin(np.clip(entries[..., 0], -1.0, 1.0))
+    ac = np.arctan2(entries[..., 1::2], entries[..., 2::2])  # a and c
+    return np.stack([ac[..., 0], b, ac[..., 1]], axis=-1)
 
 
 def from_euler(angles: np.ndarray, axes: np.ndarray) -> np.ndarray:
     """``(..., G, 3)`` intrinsic Euler angles about ``axes (G|1, 3)`` -> ``(..., G, 4)`` wxyz."""
-    angles = np.asarray(angles, float)
-    half = 0.5 * angles
-    # One elementary quaternion per angle (cos, sin on its axis), then their product.
-    parts = np.zeros(angles.shape + (4,))
-    parts[..., 0] = np.cos(half)
-    on_axis = np.broadcast_to(1 + np.asarray(axes), angles.shape)[..., None]
-    np.put_along_axis(parts, on_axis, np.sin(half)[..., None], axis=-1)
-    return quat.mul(quat.mul(parts[..., 0, :], parts[..., 1, :]), parts[..., 2, :])
+    half = 0.5 * np.asarray(angles, float)
+    cos, sin = np.cos(half), np.sin(half)
+    c0, c1, c2 = (np.stack([cos[..., n], sin[..., n]], axis=-1) for n in range(3))
+    products = c0[..., :, None, None] * c1[..., None, :, None] * c2[..., None, None, :]
+    flat = products.reshape(*half.shape[:-1], 1, 8)
+    return (flat @ _euler_products(_key(axes)))[..., 0, :]

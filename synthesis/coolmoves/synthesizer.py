@@ -38,7 +38,7 @@ from synthesis.coolmoves.blend import (
 from synthesis.coolmoves.database import Database
 from synthesis.coolmoves.features import RATE_HZ, search_vectors, sliding_windows
 from synthesis.coolmoves.foot_contact import FootContact
-from synthesis.coolmoves.knn import K_NEIGHBOURS, MAX_DISTANCE, KNNMatcher
+from synthesis.coolmoves.knn import K_NEIGHBOURS, MAX_DISTANCE, BothHandsKNN, PerHand
 from synthesis.coolmoves.limits import JointLimits
 from synthesis.coolmoves.smoothing import ewma, ewma_step
 from synthesis.coolmoves.two_bone import chain_fk
@@ -150,7 +150,7 @@ class CoolMoves(Synthesizer):
         self.database = database
         self.options = options or Options()
         self.user_height_m = user_height_m
-        self._matchers = self._make_matchers()
+        self._matcher = self._make_matcher()
         self._groups = joint_groups(database.limb_masks)
         self._limits = JointLimits(database.skeleton, widen_to=database.poses)
         ref = database.skeleton
@@ -183,14 +183,16 @@ class CoolMoves(Synthesizer):
         self._leg_length = float(np.linalg.norm(ref.offsets[list(legs[0][1:])], axis=-1).sum())
         self.reset()
 
-    def _make_matchers(self) -> list:
+    def _make_matcher(self) -> BothHandsKNN | PerHand:
         opts, db = self.options, self.database
         if opts.matcher == "knn":
-            return [KNNMatcher(db.search[s], opts.k, opts.max_distance) for s in (0, 1)]
+            return BothHandsKNN(db.search, opts.k, opts.max_distance)
         if opts.matcher == "gmm":
             from synthesis.coolmoves.gmm import GaussianMixtureMatcher
 
-            return [GaussianMixtureMatcher(db.search[s], opts.k, opts.max_distance) for s in (0, 1)]
+            return PerHand(
+                GaussianMixtureMatcher(db.search[s], opts.k, opts.max_distance) for s in (0, 1)
+            )
         raise SynthesisError(f"unknown matcher {opts.matcher!r}; use 'knn' or 'gmm'")
 
     # -- state ----------------------------------------------------------------------------
@@ -246,16 +248,8 @@ class CoolMoves(Synthesizer):
             of each joint ``(B, J)``: the global match weight where it got matches, else 0.
         """
         db, opts = self.database, self.options
-        b, k = windows.shape[0], self._matchers[0].k
-        dist = np.full((2, b, k), np.inf)
-        idx = np.full((2, b, k), -1)
-        match_weights = np.zeros((2, b, k))
-        for side in (0, 1):
-            rows = np.flatnonzero(tracked[:, side])
-            if rows.size:
-                dist[side, rows], idx[side, rows], match_weights[side, rows] = self._matchers[
-                    side
-                ].query(search_vectors(windows[rows, :, side]))
+        queries = search_vectors(np.moveaxis(windows, 2, 1))  # (B, 2, F)
+        dist, idx, match_weights = self._matcher.query(queries, tracked)
         weights, confidence = group_weights(
             dist[0], dist[1], opts.max_distance, match_weights[0], match_weights[1]
         )
