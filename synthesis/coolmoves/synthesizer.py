@@ -92,12 +92,17 @@ _LIMBS = {
 
 
 class _Limb:
-    """A two-bone limb (upper, middle, end joint) and the device point on its end joint."""
+    """Two-bone limbs (upper, middle, end joint) and the device point on each end joint.
 
-    def __init__(self, skeleton: Skeleton, joints: tuple[int, int, int], device_offset):
+    One limb, or ``S`` limbs whose root-to-end chains have one length, solved together
+    (``joints (S, 3)``, device offsets ``(S, 3)``): both arms in one pass of numpy calls.
+    """
+
+    def __init__(self, skeleton: Skeleton, joints, device_offset):
         self.offsets = skeleton.offsets
-        self.joints = joints
-        self.chain = skeleton.chain(joints[-1])
+        self.joints = np.asarray(joints)
+        self.chain = np.array([skeleton.chain(j) for j in self.joints.reshape(-1, 3)[:, -1]])
+        self.chain = self.chain.reshape(*self.joints.shape[:-1], -1)
         self.device_offset = np.asarray(device_offset, float)
 
     @classmethod
@@ -112,6 +117,17 @@ class _Limb:
         joints = tuple(skeleton.index(rig.body17[n]) for n in names)
         return cls(skeleton, joints, attachment.position)
 
+    @classmethod
+    def together(cls, skeleton: Skeleton, limbs: list[_Limb | None]) -> list[tuple[list, _Limb]]:
+        """``[(sides, limb)]``: the given single limbs as one multi-limb where their chains
+        have one length, else one by one; ``sides`` index ``limbs`` (None entries skipped)."""
+        present = [(side, limb) for side, limb in enumerate(limbs) if limb is not None]
+        if len(present) > 1 and len({limb.chain.shape for _, limb in present}) == 1:
+            joints = np.stack([limb.joints for _, limb in present])
+            offsets = np.stack([limb.device_offset for _, limb in present])
+            return [([side for side, _ in present], cls(skeleton, joints, offsets))]
+        return [([side], limb) for side, limb in present]
+
     def reach(
         self,
         rotations: np.ndarray,
@@ -120,13 +136,16 @@ class _Limb:
         device: np.ndarray,
         weight: np.ndarray,
     ) -> np.ndarray:
-        """``rotations (B, J, 4)`` with the device point moved ``weight (B,)`` of the way to
-        ``device (B, 3)`` (world), by moving the end joint as much (its rotation is kept)."""
+        """``rotations (B, J, 4)`` with the device point moved ``weight (B, [S])`` of the way
+        to ``device (B, [S,] 3)`` (world), by moving the end joint as much (its rotation is
+        kept)."""
         globs, positions = chain_fk(rotations, root, self.offsets, scale, self.chain)
-        end_pos, end_rot = positions[:, -1], globs[:, -1]
-        point = end_pos + end_rot @ self.device_offset
-        target = end_pos + weight[:, None] * (device - point)
-        return two_bone(rotations, globs[:, -4:], positions[:, -4:], self.joints, target)
+        end_pos, end_rot = positions[..., -1, :], globs[..., -1, :, :]
+        point = end_pos + (end_rot @ self.device_offset[..., None])[..., 0]
+        target = end_pos + weight[..., None] * (device - point)
+        return two_bone(
+            rotations, globs[..., -4:, :, :], positions[..., -4:, :], self.joints, target
+        )
 
 
 class CoolMoves(Synthesizer):
@@ -166,13 +185,14 @@ class CoolMoves(Synthesizer):
             # A rest pose that is not upright (Bandai's): eye height from stature instead.
             self._ref_hmd_height = EYE_HEIGHT_FRAC * self._ref_height
         drv = database.drivers
-        self._arms = [
+        arms = [
             _Limb.for_driver(ref, limb, device)
             for limb, device in ((drv.left_limb, drv.left), (drv.right_limb, drv.right))
         ]
+        self._arms = _Limb.together(ref, arms)
         legs = [[ref.index(rig.body17[f"{s}_{p}"]) for p in ("hip", "knee", "ankle")] for s in "lr"]
         self._legs = [_Limb(ref, tuple(joints), np.zeros(3)) for joints in legs]
-        arm_joints = {j for arm in self._arms if arm is not None for j in arm.joints}
+        arm_joints = {int(j) for _, arm in self._arms for j in arm.joints.ravel()}
         self._arm_limits = JointLimits(ref, widen_to=database.poses, only=arm_joints)
         ankle = ref.index(rig.body17["l_ankle"])
         self._ankle_standing = (
@@ -293,9 +313,8 @@ class CoolMoves(Synthesizer):
         rotations = clamp(smoothed)
         root = self._place(rotations, hmd, scale)
         if self.options.arm_ik > 0 and hands_ok.any():
-            for side, arm in enumerate(self._arms):
-                if arm is None:
-                    continue
+            for sides, arm in self._arms:
+                side = sides if arm.joints.ndim == 2 else sides[0]
                 weight = np.where(hands_ok[:, side], self.options.arm_ik, 0.0)
                 rotations = arm.reach(rotations, root, scale, hands[:, side], weight)
             # The head chain does not pass through an arm: the placement stays exact.

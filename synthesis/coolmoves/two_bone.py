@@ -12,8 +12,9 @@ and leg IK in games (e.g. Unity's TwoBoneIKConstraint):
   possible: the blended database pose decides where the elbow points;
 - the end joint keeps its global orientation (hand or foot do not tilt).
 
-Vectorised over ``B`` poses. Forward kinematics along one chain (:func:`chain_fk`) with numpy
-matrices: the hot path of ``step()`` cannot afford scipy objects (see :mod:`.rotations`).
+Vectorised over ``B`` poses and ``S`` limbs (both arms in one pass). Forward kinematics
+along the chains (:func:`chain_fk`) with numpy matrices: the hot path of ``step()``
+cannot afford scipy objects (see :mod:`.rotations`).
 """
 
 from __future__ import annotations
@@ -30,22 +31,29 @@ _X, _Z = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
 def chain_fk(
     rotations: np.ndarray, root: np.ndarray, offsets: np.ndarray, scale: np.ndarray, chain
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Global rotation matrices ``(B, L, 3, 3)`` and positions ``(B, L, 3)`` along ``chain``.
+    """Global rotation matrices ``(B, [S,] L, 3, 3)`` and positions ``(B, [S,] L, 3)`` along
+    ``chain``, or along ``S`` chains of one length at once (both arms in one pass).
 
     Args:
         rotations: ``(B, J, 4)`` local rotations. root: ``(B, 3)`` position of ``chain[0]``.
         offsets: ``(J, 3)`` rest offsets of the unscaled rig; scale: ``(B,)`` bone scale.
-        chain: ``L`` joint indices from the root, each the parent of the next.
+        chain: ``(L,)`` or ``(S, L)`` joint indices from the root, each the parent of the next.
     """
-    mats = to_matrix(rotations[:, chain])
-    glob, pos = mats[:, 0], np.asarray(root, float)
+    chain = np.asarray(chain)
+    mats = to_matrix(rotations[:, chain])  # (B, [S,] L, 3, 3)
+    pos = np.asarray(root, float)
+    if chain.ndim == 2:
+        pos = np.broadcast_to(pos[:, None], (pos.shape[0], chain.shape[0], 3))
+    scale = np.reshape(scale, (-1,) + (1,) * (pos.ndim - 1))
+    steps = offsets[chain[..., 1:]][..., None]  # (S|, L-1, 3, 1)
+    glob = mats[..., 0, :, :]
     globs, positions = [glob], [pos]
-    for link, j in enumerate(chain[1:], start=1):
-        pos = pos + scale[:, None] * (glob @ offsets[j])
-        glob = glob @ mats[:, link]
+    for link in range(1, chain.shape[-1]):
+        pos = pos + scale * (glob @ steps[..., link - 1, :, :])[..., 0]
+        glob = glob @ mats[..., link, :, :]
         globs.append(glob)
         positions.append(pos)
-    return np.stack(globs, axis=1), np.stack(positions, axis=1)
+    return np.stack(globs, axis=-3), np.stack(positions, axis=-2)
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -62,21 +70,21 @@ def _unit(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _arc(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``(B, 4)`` smallest rotations turning directions ``a`` onto ``b`` ``(B, 3)``."""
+    """``(..., 4)`` smallest rotations turning directions ``a`` onto ``b`` ``(..., 3)``."""
     a, _ = _unit(a)
     b, _ = _unit(b)
     q = np.concatenate([1.0 + np.sum(a * b, axis=-1, keepdims=True), _cross(a, b)], axis=-1)
     # Antiparallel directions never occur between a bone and its corrected self; guard anyway.
-    return np.where(q[:, :1] > _EPS, q, quat.IDENTITY) / np.maximum(
+    return np.where(q[..., :1] > _EPS, q, quat.IDENTITY) / np.maximum(
         np.linalg.norm(q, axis=-1, keepdims=True), _EPS
     )
 
 
 def _in_frame(q: np.ndarray, frame: np.ndarray) -> np.ndarray:
-    """World rotation ``q (B, 4)`` expressed in the local axes ``frame (B, 3, 3)``:
+    """World rotation ``q (..., 4)`` expressed in the local axes ``frame (..., 3, 3)``:
     ``frame^T R frame`` is the same angle about the axis ``frame^T n``."""
-    vec = np.einsum("bji,bj->bi", frame, q[:, 1:])
-    return np.concatenate([q[:, :1], vec], axis=-1)
+    vec = (q[..., None, 1:] @ frame)[..., 0, :]
+    return np.concatenate([q[..., :1], vec], axis=-1)
 
 
 def solve(
@@ -86,17 +94,19 @@ def solve(
     joints: tuple[int, int, int],
     target: np.ndarray,
 ) -> np.ndarray:
-    """Local rotations ``(B, J, 4)`` with the end joint of ``joints`` moved to ``target``.
+    """Local rotations ``(B, J, 4)`` with the end joint of ``joints`` moved to ``target``,
+    for one limb or ``S`` limbs at once (the bracketed axes).
 
     Args:
         rotations: ``(B, J, 4)`` local rotations.
-        globs, positions: ``(B, 4, 3, 3)`` and ``(B, 4, 3)`` global rotations and positions of
-            the upper joint's parent, the upper, middle and end joints (from :func:`chain_fk`).
-        joints: indices of the upper, middle and end joints (shoulder, elbow, wrist).
-        target: ``(B, 3)`` where the end joint should go.
+        globs, positions: ``(B, [S,] 4, 3, 3)`` and ``(B, [S,] 4, 3)`` global rotations and
+            positions of the upper joint's parent, the upper, middle and end joints (from
+            :func:`chain_fk`).
+        joints: indices ``(3,)`` or ``(S, 3)`` of the upper, middle and end joints.
+        target: ``(B, [S,] 3)`` where the end joint should go.
     """
-    parent, upper, middle = globs[:, 0], globs[:, 1], globs[:, 2]
-    a, b, c = positions[:, 1], positions[:, 2], positions[:, 3]
+    parent, upper, middle = globs[..., 0, :, :], globs[..., 1, :, :], globs[..., 2, :, :]
+    a, b, c = positions[..., 1, :], positions[..., 2, :], positions[..., 3, :]
     u1, l1 = _unit(b - a)
     u2, l2 = _unit(c - b)
     d = np.clip(np.linalg.norm(target - a, axis=-1), np.abs(l1 - l2) + 1e-9, l1 + l2 - 1e-9)
@@ -104,19 +114,26 @@ def solve(
     #    root and end are ``d`` apart (law of cosines on the bend angle u1 -> u2).
     normal, bent = _unit(_cross(u1, u2))
     straight = bent < 1e-9  # a fully straight limb has no plane: bend about a horizontal axis
-    fallback, _ = _unit(_cross(u1, np.where(np.abs(u1[:, 2:]) < 0.9, _Z, _X)))
-    normal = np.where(straight[:, None], fallback, normal)
+    fallback, _ = _unit(_cross(u1, np.where(np.abs(u1[..., 2:]) < 0.9, _Z, _X)))
+    normal = np.where(straight[..., None], fallback, normal)
     bend_now = np.arctan2(bent, np.sum(u1 * u2, axis=-1))
     cos_bend = np.clip((d**2 - l1**2 - l2**2) / (2.0 * l1 * l2), -1.0, 1.0)
     turn_lower = quat.from_axis_angle(normal, np.arccos(cos_bend) - bend_now)
     new_c = b + quat.rotate(turn_lower, c - b)
     # 2. Swing the whole limb at the root, by the smallest rotation, onto the target.
     turn_upper = _arc(new_c - a, target - a)
-    i, j, k = joints
-    out = rotations.copy()
-    out[:, i] = quat.mul(_in_frame(turn_upper, parent), rotations[:, i])
-    out[:, j] = quat.mul(_in_frame(turn_lower, upper), rotations[:, j])
+    i, j, k = np.moveaxis(np.asarray(joints), -1, 0)
     # The end joint keeps its global rotation: undo both turns in the old middle frame.
     both = quat.mul(turn_upper, turn_lower)
-    out[:, k] = quat.mul(quat.conj(_in_frame(both, middle)), rotations[:, k])
+    turns = np.stack(
+        [
+            _in_frame(turn_upper, parent),
+            _in_frame(turn_lower, upper),
+            quat.conj(_in_frame(both, middle)),
+        ],
+        axis=-2,
+    )  # (B, [S,] 3, 4)
+    ijk = np.stack([i, j, k], axis=-1)
+    out = rotations.copy()
+    out[:, ijk] = quat.mul(turns, rotations[:, ijk])
     return out
