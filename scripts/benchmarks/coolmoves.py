@@ -78,6 +78,14 @@ def run(quick: bool = False) -> list[BenchRow]:
             note,
         ),
         BenchRow(
+            "coolmoves step p50 (paper, no arm IK)",
+            "ms",
+            float(np.percentile(paper_lat, 50)),
+            PAPER_BACKEND_MS,
+            "paper Python backend (152 Hz)",
+            note,
+        ),
+        BenchRow(
             "coolmoves step p99 (paper, no arm IK)",
             "ms",
             float(np.percentile(paper_lat, 99)),
