@@ -13,6 +13,7 @@ from typing import Any
 
 from rich.console import Console
 
+from scripts.report_html import render_report
 from scripts.results import CheckResult, junit_xml, versions, write_atomic, write_json
 from scripts.run_context import RunContext
 from scripts.scenario import Scenario, ScenarioError
@@ -68,12 +69,18 @@ def run_scenario(
         "metrics": ctx.metrics,
         "seeds": {"scenario": scenario.seed},
         **ctx.info,
-        "outputs": {**ctx.outputs, "results_json": "results.json", "junit_xml": "junit.xml"},
+        "outputs": {
+            **ctx.outputs,
+            "results_json": "results.json",
+            "junit_xml": "junit.xml",
+            "report_html": "report.html",
+        },
         "timings_s": timings,
         "versions": versions(),
     }
     write_atomic(
         out_dir / "junit.xml", junit_xml(scenario.name, checks, time.perf_counter() - start)
     )
+    write_atomic(out_dir / "report.html", render_report(results, out_dir))
     write_json(out_dir / "results.json", results)
     return results

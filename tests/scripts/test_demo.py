@@ -58,3 +58,13 @@ def test_strip_shows_a_body(short_run):
         centre = p[150:300, 120:200].reshape(-1, 3)
         corner = p[:20, :20].reshape(-1, 3).mean(0)
         assert np.mean(np.linalg.norm(centre - corner, axis=1) > 40) > 0.1
+
+
+def test_html_report_is_self_contained(short_run):
+    out, results = short_run
+    page = (out / "report.html").read_text()
+    assert "<h1>Scenario <code>default</code>" in page
+    for check in results["checks"]:
+        assert check["name"] in page
+    # Pictures are inlined, so the page works when mailed or archived on its own.
+    assert page.count('src="data:image/png;base64,') >= 2 and 'src="out' not in page
