@@ -1,15 +1,16 @@
 """Cyclic locomotion: walk, run, and walking while dribbling a ball with the right hand.
 
-Feet follow :func:`~avatar_models.generator.feet.gait_track`; the pelvis travels at constant
-speed with lateral sway, rotation and list, and its height is the lower of a bobbing curve and
-what the legs can reach; the trunk counter-rotates, arms swing opposite the legs.
+Feet follow :func:`~avatar_models.generator.feet.gait_track`; the pelvis sways, rotates and
+lists, and its height is the lower of a bobbing curve and what the legs can reach; the trunk
+counter-rotates, arms swing opposite the legs.
 Cadence and stride defaults: walking about 0.95 strides/s with a stride of 0.78 stature
 (about 1.35 m/s for 1.75 m; Grieve & Gear 1966, Perry & Burnfield ch. 1); running about
 1.4 strides/s with 1.3 statures per stride (about 3.2 m/s; Novacheck 1998, Gait & Posture 7).
 
-Running moves the whole-body centre of mass, not the pelvis, on a spring-mass path (constant
-speed, ballistic flights): the swinging legs carry a sixth of the mass each, so a pelvis on
-that path asks a floor the body is not touching for their momentum changes. The running swing
+The whole-body centre of mass, not the pelvis, travels at constant forward speed, and in
+running also bounces on a spring-mass path (ballistic flights): the swinging legs carry a
+sixth of the mass each, so a pelvis at constant speed asks the floor (or, in flight, nothing)
+for their momentum changes. The running swing
 lifts the heel high behind (ankle 0.17 statures up at mid-swing: a tightly folded leg
 swings through with less inertia, Novacheck 1998) and the foot hangs toes-down from the
 flexed knee.
@@ -56,8 +57,11 @@ class Gait:
     lean: float
 
 
+# The walking heel rises by 38 deg before toe-off: with the pelvis surging over the stance foot
+# (constant-speed centre of mass), a flatter late stance dorsiflexes the ankle past the
+# humanoid's 40 deg (the IK then cannot reproduce the walk on its own rig).
 WALK = Gait(
-    0.95, 0.78, (0.85, 1.7), 0.62, 12, 30, 0.055, SWING_LIFT, 0, 0.012, 0.03, False, 5, 18, 15, 2
+    0.95, 0.78, (0.85, 1.7), 0.62, 12, 38, 0.055, SWING_LIFT, 0, 0.012, 0.03, False, 5, 18, 15, 2
 )
 RUN = Gait(1.4, 1.3, (2.2, 4.5), 0.38, 4, 35, 0.17, 0.06, 65, 0.03, 0.08, True, 8, 30, 85, 8)
 DRIBBLE = Gait(
@@ -152,7 +156,24 @@ def _gait_plan(scene: Scene, gait: Gait) -> tuple[Plan, np.ndarray]:
 
     if gait.running:
         plan.root_pos = _spring_mass_root(scene, plan, travel, bob, limit_of)
+    else:
+        plan.root_pos = _steady_travel_root(scene, plan, travel, limit_of)
     return plan, phase_l
+
+
+def _steady_travel_root(
+    scene: Scene, plan: Plan, travel: np.ndarray, limit_of: Callable[[np.ndarray], np.ndarray]
+) -> np.ndarray:
+    """``(T, 3)`` root positions whose centre of mass travels forward at the constant speed
+    of ``travel (T,)``: the pelvis surges against the swinging leg, so the stance foot is not
+    asked for the swing leg's horizontal force. Heights are the plan's, lowered smoothly where
+    the legs would not reach their feet (the root under ``limit_of(root_xy (T, 2)) (T,)``)."""
+    offset = plan_centre_of_mass(scene, plan)[:, 0] - plan.root_pos[:, 0]
+    wanted = np.full((scene.n_frames, 3), np.nan)
+    wanted[:, 0] = travel + offset.mean()
+    root = follow_centre_of_mass(scene, plan, wanted)
+    root[:, 2] = smooth_cap(root[:, 2], limit_of(root[:, :2]), scene.fps, CAP_HALF_WIDTH_S)
+    return root
 
 
 def _spring_mass_root(

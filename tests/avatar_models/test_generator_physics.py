@@ -26,22 +26,9 @@ UNSUPPORTED = {"climb_ladder", "swim"}  # no ladder or water in the physics scen
 EXPECTED_FAILURES = {"floating", "residual_force"}
 
 
-# Known gap, strict so that a fix shows up: the tall fast walker's swing foot travels a 1.5 m
-# stride in 0.25 s, whose horizontal force the floor cannot give. Moving the centre of mass
-# (not the pelvis) at constant speed passes, but the pelvis then surges and the tracking
-# controller (tests/sim/test_tracking.py) loses the built-in walk.
-KNOWN_GAPS = {("walk", 1)}
-
-
 @pytest.mark.parametrize(
     ("activity", "i"),
-    [
-        pytest.param(a, i, marks=pytest.mark.xfail(strict=True, reason="known gap"))
-        if (a, i) in KNOWN_GAPS
-        else (a, i)
-        for a in ACTIVITIES
-        for i in range(len(SUBJECTS))
-    ],
+    [(a, i) for a in ACTIVITIES for i in range(len(SUBJECTS))],
 )
 def test_generated_activity_is_physically_plausible(activity, i):
     report = check_motion(generate(activity, SUBJECTS[i], duration_s=2.5, seed=i))
