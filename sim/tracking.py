@@ -36,6 +36,13 @@ simulated minus reference, in world coordinates, gains ``g`` along the reference
 sideways) and ``J_hip`` the ankle's horizontal Jacobian over the hip hinges, so the next
 stance foot lands where it can bring the body back onto the reference.
 
+Timing (phase adaptation): the reference is played on its own clock, whose rate is ``1 +
+k e_fwd`` (bounded), ``e_fwd`` the capture-point error along the heading. A body ahead of its
+reference gets the reference's next steps sooner instead of being pulled back through its
+stance foot, which the friction and the sole's size cannot always do (step-timing adaptation
+of gait controllers, e.g. Khadiv et al. 2016 "Step timing adjustment: a step toward generating
+robust gaits"). Errors and falls are judged against the reference at its clock.
+
 Nothing acts on the root: no actuator on the free joint, ``xfrc_applied`` and
 ``qfrc_applied`` stay zero (tested).
 
@@ -85,6 +92,10 @@ class TrackingSettings:
         capture_gain: foot-placement shift per metre of capture-point error (simulated minus
             reference), along the reference's heading and sideways.
         max_step_shift: bound on the foot-placement shift (m).
+        clock_gain: reference clock rate change per metre of forward capture-point error
+            (simulated minus reference): a body ahead of its reference plays the reference
+            faster, one behind plays it slower (1/m).
+        max_clock_change: bound on the clock rate's departure from 1.
         swing_ramp_s: the shift fades in over this time after lift-off.
         stance_height: a reference foot stands while its ankle is within this of its lowest
             height in the clip (m).
@@ -113,8 +124,10 @@ class TrackingSettings:
     com_weight: tuple[float, float, float] = (3.0, 3.0, 3.0)
     kp_com: float = 20.0
     kd_com: float = 10.0
-    capture_gain: tuple[float, float] = (0.2, 0.3)
+    capture_gain: tuple[float, float] = (0.2, 0.5)
     max_step_shift: float = 0.25
+    clock_gain: float = 2.0
+    max_clock_change: float = 0.2
     swing_ramp_s: float = 0.15
     stance_height: float = 0.03
     smoothing_frames: float = 1.0
@@ -134,6 +147,8 @@ class TrackingResult:
         power: ``(T,)`` mechanical power sum |tau * qd| over the hinges (W).
         fall_frame: first frame judged fallen, or ``None``.
         fps: reference frame rate.
+        reference_frame: ``(T,)`` the (fractional) reference frame played at each frame
+            (:attr:`TrackingSettings.clock_gain`); errors and falls are judged against it.
     """
 
     qpos: np.ndarray
@@ -142,6 +157,7 @@ class TrackingResult:
     power: np.ndarray
     fall_frame: int | None
     fps: float
+    reference_frame: np.ndarray
 
     @property
     def fell(self) -> bool:
@@ -227,6 +243,13 @@ def _yaw(q: np.ndarray) -> float:
     """Heading (rad) of the root's local +X for a wxyz quaternion."""
     w, x, y, z = q
     return float(np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z)))
+
+
+def _heading(q: np.ndarray) -> np.ndarray:
+    """``(2, 2)`` rotation taking world horizontal vectors to (forward, left) of the heading
+    of configuration ``q (nq,)``."""
+    yaw = _yaw(q[3:7])
+    return np.array([[np.cos(yaw), np.sin(yaw)], [-np.sin(yaw), np.cos(yaw)]])
 
 
 def _yaw_quat(angle: float, quats: np.ndarray) -> np.ndarray:
@@ -364,9 +387,11 @@ class Tracker:
         frame_of_step = np.floor(np.arange(1, steps + 1) * m.opt.timestep * fps + 1e-9).astype(int)
         q_target = np.empty(m.nq)
         tau = np.zeros(m.nu)
+        clock, rate = 0.0, 1.0  # reference frame index played now, frames per frame
+        reference_frame = np.zeros(n)
         for k in range(steps):  # the simulation is sequential by nature
             if k % s.control_period == 0:
-                phase = k * m.opt.timestep * fps
+                phase = min(clock, n - 1.0)
                 i = min(int(phase), n - 2)
                 a = min(phase - i, 1.0)
                 q_target[:] = qpos_ref[i]
@@ -376,17 +401,24 @@ class Tracker:
                 swinging = (1 - a) * swing[i] + a * swing[i + 1]
                 com = [(1 - a) * r[i] + a * r[i + 1] for r in (com_ref, com_vel_ref, com_acc_ref)]
                 self._com_jacobian()
-                self._place_feet(q_target, self._step_shift(q_target, com), swinging)
+                error = self._capture_error(q_target, com)
+                bound = s.max_clock_change
+                rate = 1.0 + np.clip(s.clock_gain * error[0], -bound, bound)
+                self._place_feet(q_target, self._step_shift(q_target, error), swinging)
                 standing = (swinging == 0) & s.level_stance_feet
                 tau = self._torques(q_target, v_target, a_target, com, standing)
             d.ctrl[:] = tau
             mujoco.mj_step2(m, d)
             mujoco.mj_step1(m, d)
+            clock += rate * m.opt.timestep * fps
             t = frame_of_step[k]
             if t < n and (k == 0 or frame_of_step[k - 1] != t):
+                reference_frame[t] = min(clock, n - 1.0)
                 qpos[t], sites[t] = d.qpos, d.site_xpos[self.sites]
                 torque[t] = d.actuator_force
                 power[t] = np.abs(d.actuator_force * d.qvel[self.dof]).sum()
+        ref_sites = _at_frames(ref_sites, reference_frame)
+        qpos_ref = qpos_ref[np.round(reference_frame).astype(int)]
         return TrackingResult(
             qpos=qpos,
             body17_error=np.linalg.norm(sites - ref_sites, axis=-1),
@@ -394,24 +426,28 @@ class Tracker:
             power=power,
             fall_frame=self._fall_frame(qpos, qpos_ref, sites, ref_sites),
             fps=fps,
+            reference_frame=reference_frame,
         )
 
     def _com_jacobian(self):
         """``(3, nv)`` Jacobian of the whole-body centre of mass in the current state."""
         mujoco.mj_jacSubtreeCom(self.model, self.data, self._jac_com, 0)
 
-    def _step_shift(self, q_target: np.ndarray, com: list[np.ndarray]) -> np.ndarray:
-        """``(3,)`` world shift of a swinging foot's target: the capture-point error
-        (simulated minus reference, horizontal) times :attr:`TrackingSettings.capture_gain`,
-        bounded by ``max_step_shift``. ``com``: reference centre of mass position, velocity,
-        acceleration ``(3,)`` each."""
-        s, d = self.settings, self.data
-        yaw = _yaw(q_target[3:7])
-        heading = np.array([[np.cos(yaw), np.sin(yaw)], [-np.sin(yaw), np.cos(yaw)]])
+    def _capture_error(self, q_target: np.ndarray, com: list[np.ndarray]) -> np.ndarray:
+        """``(2,)`` horizontal capture-point error, simulated minus reference, along the
+        reference heading and to its left (m). ``com``: reference centre of mass position,
+        velocity, acceleration ``(3,)`` each."""
+        d = self.data
         omega = np.sqrt(GRAVITY / com[0][2])
         capture = d.subtree_com[0, :2] + (self._jac_com @ d.qvel)[:2] / omega
-        error = heading @ (capture - com[0][:2] - com[1][:2] / omega)  # (forward, left)
-        shift = heading.T @ (np.asarray(s.capture_gain) * error)
+        return _heading(q_target) @ (capture - com[0][:2] - com[1][:2] / omega)
+
+    def _step_shift(self, q_target: np.ndarray, error: np.ndarray) -> np.ndarray:
+        """``(2,)`` world shift of a swinging foot's target: the capture-point ``error (2,)``
+        (:meth:`_capture_error`) times :attr:`TrackingSettings.capture_gain`, bounded by
+        ``max_step_shift``."""
+        s = self.settings
+        shift = _heading(q_target).T @ (np.asarray(s.capture_gain) * error)
         norm = np.linalg.norm(shift)
         if norm > s.max_step_shift:
             shift *= s.max_step_shift / norm
@@ -519,6 +555,14 @@ class Tracker:
         tilt = np.degrees(np.arccos(np.clip(np.sum(_up(qpos) * _up(qpos_ref), -1), -1, 1)))
         fallen = np.flatnonzero(low | (tilt > self.settings.fall_tilt_deg))
         return int(fallen[0]) if fallen.size else None
+
+
+def _at_frames(values: np.ndarray, frames: np.ndarray) -> np.ndarray:
+    """``values (T, ...)`` linearly interpolated at fractional frame indices ``frames (T',)``
+    (within ``[0, T - 1]``)."""
+    i = np.minimum(frames.astype(int), values.shape[0] - 2)
+    a = (frames - i).reshape(-1, *([1] * (values.ndim - 1)))
+    return (1 - a) * values[i] + a * values[i + 1]
 
 
 def _up(qpos: np.ndarray) -> np.ndarray:
