@@ -28,6 +28,9 @@ from avatar_models import AvatarsimError
 # Fixed zip entry time so that the same stream always gives the same file bytes.
 _ZIP_EPOCH = (1980, 1, 1, 0, 0, 0)
 _ARRAYS = ("device_names", "timestamps", "positions", "quaternions", "valid")
+# A timestamp this far from its neighbours' clock is a glitch: transport jitter is milliseconds
+# and out-of-order packets are off by a period or two, so 1 s leaves a wide margin.
+CLOCK_TOLERANCE_S = 1.0
 
 
 class StreamError(AvatarsimError, ValueError):
@@ -52,6 +55,34 @@ class UnknownDeviceError(AvatarsimError, KeyError):
 
     def __str__(self) -> str:  # KeyError would repr() the message
         return self.args[0]
+
+
+def clock_outliers(
+    timestamps: np.ndarray, tolerance_s: float = CLOCK_TOLERANCE_S, half_window: int = 8
+) -> np.ndarray:
+    """``(T,)`` bool: timestamps that disagree with the clock of their arrival neighbours.
+
+    A device delivers samples in order at a steady period ``p`` (the median step between
+    distinct sorted stamps), so around arrival ``i`` the stamps follow ``t_j ≈ c + j·p``. The
+    local offset ``c`` is the median of ``t_j - j·p`` over the ``2·half_window + 1`` arrivals
+    centred on ``i`` (fewer at the ends); a stamp further than ``tolerance_s`` from
+    ``c + i·p`` is a glitch (e.g. a garbage clock value of 1000 s in a 2 s stream). A median,
+    not a global fit, so that a genuine pause in delivery keeps both sides: a run of at least
+    ``half_window + 1`` consistent arrivals is its own majority.
+
+    Args:
+        timestamps: ``(T,)`` finite seconds, in arrival order.
+    """
+    ts = np.asarray(timestamps, float)
+    steps = np.diff(np.unique(ts))
+    if steps.size == 0:
+        return np.zeros(ts.shape, bool)
+    period = float(np.median(steps))
+    index = np.arange(ts.size)
+    offsets = np.pad(ts - index * period, half_window, constant_values=np.nan)
+    windows = np.lib.stride_tricks.sliding_window_view(offsets, 2 * half_window + 1)
+    expected = np.nanmedian(windows, axis=1) + index * period
+    return np.abs(ts - expected) > tolerance_s
 
 
 @dataclass(frozen=True, eq=False)
@@ -185,11 +216,14 @@ class TrackingStream:
     def repaired(self) -> TrackingStream:
         """A stream that passes :meth:`validate`, for consumers of untrusted input.
 
-        Samples are stably sorted by timestamp, samples with a non-finite or repeated timestamp
-        are dropped (the first arrival is kept), and non-finite poses are marked invalid and
-        NaN-filled. ``meta["repairs"]`` counts what was changed.
+        Samples are stably sorted by timestamp; samples with a non-finite or repeated timestamp
+        (the first arrival is kept) or a glitched one (:func:`clock_outliers`) are dropped, and
+        non-finite poses are marked invalid and NaN-filled. ``meta["repairs"]`` counts what
+        was changed.
         """
-        keep = np.flatnonzero(np.isfinite(self.timestamps))
+        finite = np.flatnonzero(np.isfinite(self.timestamps))
+        glitched = clock_outliers(self.timestamps[finite])
+        keep = finite[~glitched]
         order = keep[np.argsort(self.timestamps[keep], kind="stable")]
         ts = self.timestamps[order]
         first = np.concatenate([[True], np.diff(ts) > 0]) if ts.size else np.zeros(0, bool)
@@ -201,6 +235,7 @@ class TrackingStream:
             "reordered": int(np.sum(np.diff(order) < 0)),
             "dropped_samples": int(self.n_samples - order.size),
             "invalidated": int(np.sum(out.valid & ~finite)),
+            "clock_outliers": int(glitched.sum()),
         }
         return out.replace(
             positions=np.where(valid[..., None], out.positions, np.nan),

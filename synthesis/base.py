@@ -75,19 +75,43 @@ def usable_mask(stream: TrackingStream) -> np.ndarray:
     return stream.valid & finite
 
 
+def max_clock_span_s(timestamps: np.ndarray) -> float:
+    """The longest time ``on_clock`` accepts for sorted, distinct ``timestamps (T,)``.
+
+    The samples account for ``T`` median periods of their own clock; a stream may miss up
+    to as much again (tracking pauses) plus one second. Beyond that the empty ticks
+    outnumber the samples and the stream's clock is broken, not paused.
+    """
+    steps = np.diff(timestamps)
+    period = float(np.median(steps)) if steps.size else 0.0
+    return 2.0 * timestamps.size * period + 1.0
+
+
 def on_clock(stream: TrackingStream, rate_hz: float | None = None) -> TrackingStream:
     """``stream`` repaired and placed on a regular clock ``t0 + k / rate_hz``.
 
     Each sample goes to the nearest tick (timestamp jitter is below half a period); ticks
     that received no sample are invalid (NaN), and of two samples on one tick the later
-    one wins. Out-of-order, duplicate and NaN samples are handled by
+    one wins. Out-of-order, duplicate, NaN and glitched samples are handled by
     :meth:`TrackingStream.repaired` first.
+
+    Raises:
+        SynthesisError: no sample has a finite timestamp, or the samples span more than
+            :func:`max_clock_span_s` (a clock jump that would make ``run`` step mostly
+            empty ticks for as long as the jump, e.g. a day of them).
     """
     rate = float(rate_hz or stream.rate_hz or DEFAULT_RATE_HZ)
     clean = stream.repaired()
     if clean.n_samples == 0:
         raise SynthesisError("the tracking stream has no sample with a finite timestamp")
     t0 = float(clean.timestamps[0])
+    span = float(clean.timestamps[-1]) - t0
+    if span > max_clock_span_s(clean.timestamps):
+        raise SynthesisError(
+            f"the tracking stream's {clean.n_samples} samples span {span:.6g} s, more than "
+            f"{max_clock_span_s(clean.timestamps):.6g} s (twice their own duration + 1 s); "
+            "its clock jumps (e.g. a reset or a garbage timestamp run): split it at the jump"
+        )
     ticks = np.rint((clean.timestamps - t0) * rate).astype(np.int64)
     n = int(ticks[-1]) + 1
     positions = np.full((n, clean.n_devices, 3), np.nan)

@@ -90,8 +90,32 @@ def test_repaired_sorts_stably_and_keeps_first_duplicate():
     fixed = stream.replace(timestamps=ts, positions=marker).repaired()
     np.testing.assert_array_equal(fixed.timestamps, [0.0, 0.1, 0.2, 0.3])
     np.testing.assert_array_equal(fixed.positions[:, 0, 0], [0, 2, 1, 5])  # first 0.1 arrival
-    assert fixed.meta["repairs"] == {"reordered": 1, "dropped_samples": 2, "invalidated": 0}
+    assert fixed.meta["repairs"] == {
+        "reordered": 1,
+        "dropped_samples": 2,
+        "invalidated": 0,
+        "clock_outliers": 0,
+    }
     fixed.validate()
+
+
+@pytest.mark.parametrize("glitched", [[0], [40], [88, 89], [30, 31, 32]])
+def test_repaired_drops_timestamps_far_from_the_stream_clock(glitched):
+    stream = static_stream(90, 1)
+    ts = stream.timestamps.copy()
+    ts[glitched] = 1000.0 + np.arange(len(glitched)) / 90.0
+    fixed = stream.replace(timestamps=ts).repaired()
+    np.testing.assert_array_equal(fixed.timestamps, np.delete(stream.timestamps, glitched))
+    assert fixed.meta["repairs"]["clock_outliers"] == len(glitched)
+    assert fixed.meta["repairs"]["dropped_samples"] == len(glitched)
+
+
+def test_repaired_keeps_both_sides_of_a_pause_in_delivery():
+    stream = static_stream(90, 1)
+    ts = stream.timestamps + np.where(np.arange(90) >= 45, 5.0, 0.0)  # 5 s without samples
+    fixed = stream.replace(timestamps=ts).repaired()
+    np.testing.assert_array_equal(fixed.timestamps, ts)
+    assert fixed.meta["repairs"]["clock_outliers"] == 0
 
 
 def test_npz_round_trip_keeps_nan_and_meta(tmp_path):
