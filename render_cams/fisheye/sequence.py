@@ -6,7 +6,8 @@ Writes, under ``out_dir``:
   bad frames injected (ControllerPose §4.2, about 1 in 50) when ``bad_frame_rate > 0``;
 - ``<camera>/NNNNNN_range.png``: 16-bit range along each pixel's ray in millimetres (0 = none);
 - ``keypoints.json``: seed, camera models and one self-describing record per camera frame
-  (:mod:`render_cams.fisheye.records`), incl. the bad-frame ground truth;
+  (:mod:`render_cams.fisheye.records`), incl. the bad-frame ground truth; no timings or
+  absolute paths, so that the same motion and seed give the same bytes in any folder;
 - ``fisheye.mp4``: the four cameras tiled 2x2, for a person to watch.
 
 Frames are rendered at the sensor's 30 Hz (ControllerPose §4.1 cameras); ``scale`` shrinks
@@ -134,17 +135,22 @@ def render_fisheye_sequence(
             )
         )
     flagged = np.stack([bad_frames.detect(images[c]) for c in range(n_cams)])
-    summary = {
+    # The data record depends on the seed alone (same seed => same bytes); the wall-clock
+    # speed and the folder it was written to go in the returned summary only.
+    recording = {
         "frames": int(n_frames),
         "cameras": names,
         "fps": rate_hz,
-        "fps_rendered": n_frames * n_cams / max(elapsed, 1e-9),
         "bad_frames": bad_frames.precision_recall(truth.ravel(), flagged.ravel()),
         "seed": seed,
         "model": model.as_dict(),
+    }
+    (out / "keypoints.json").write_text(json.dumps({**recording, "records": frames_json}))
+    summary = {
+        **recording,
+        "fps_rendered": n_frames * n_cams / max(elapsed, 1e-9),
         "out_dir": str(out),
     }
-    (out / "keypoints.json").write_text(json.dumps({**summary, "records": frames_json}))
     if video:
         tiled = np.concatenate(
             [np.concatenate(list(images[r : r + 2]), axis=2) for r in range(0, n_cams, 2)], axis=1

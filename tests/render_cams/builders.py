@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -49,3 +51,9 @@ def static_stream(samples: int, devices: int, rate_hz: float = 90.0) -> Tracking
         valid=np.ones((samples, devices), bool),
         meta={"rate_hz": rate_hz},
     )
+
+
+def folder_bytes(root: Path) -> dict[str, bytes]:
+    """Every file under ``root`` by its relative path, for byte-for-byte comparisons."""
+    files = sorted(p for p in root.rglob("*") if p.is_file())
+    return {str(p.relative_to(root)): p.read_bytes() for p in files}

@@ -8,6 +8,7 @@ import numpy as np
 from avatar_models.generator import generate
 from render_cams.fisheye.records import model_from_record
 from render_cams.fisheye.sequence import render_fisheye_sequence
+from tests.render_cams.builders import folder_bytes
 
 
 def test_sequence_files_and_records_reproject_with_opencv(tmp_path):
@@ -29,3 +30,13 @@ def test_sequence_files_and_records_reproject_with_opencv(tmp_path):
     shown = np.array(record["in_image"])
     assert shown.any()
     np.testing.assert_allclose(uv[shown, 0], np.array(record["keypoints_px"])[shown], atol=1e-3)
+
+
+def test_same_seed_gives_the_same_bytes_in_any_folder(tmp_path):
+    motion = generate("wave", duration_s=0.2, fps=30)
+    first = render_fisheye_sequence(motion, tmp_path / "a", seed=3, scale=0.1)
+    second = render_fisheye_sequence(motion, tmp_path / "nested" / "b", seed=3, scale=0.1)
+    files = folder_bytes(tmp_path / "a")
+    assert "keypoints.json" in files and "fisheye.mp4" in files
+    assert files == folder_bytes(tmp_path / "nested" / "b")
+    assert first["out_dir"] != second["out_dir"] and first["fps_rendered"] > 0  # summary only
