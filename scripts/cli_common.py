@@ -7,6 +7,7 @@ CLI discovers them, so adding a command never edits ``cli.py``.
 from __future__ import annotations
 
 import functools
+import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Any
@@ -15,6 +16,8 @@ import typer
 from rich.console import Console
 
 from avatar_models.errors import AvatarsimError
+
+INTERNAL_ERROR = 3  # exit code of a bug (0 ok, 1 a check failed, 2 bad input)
 
 
 def make_app() -> typer.Typer:
@@ -33,7 +36,11 @@ SeedOpt = Annotated[int, typer.Option("--seed", help="Seed for everything stocha
 
 
 def user_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
-    """Turn avatarsim's typed errors into a one-line reason on stderr and exit code 2."""
+    """Turn avatarsim's typed errors into a one-line reason on stderr and exit code 2.
+
+    Anything else is a bug, not bad input: it exits 3 (never 1, which means "a check failed"),
+    with the traceback when ``AVATARSIM_DEBUG=1``.
+    """
 
     @functools.wraps(fn)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
@@ -42,6 +49,18 @@ def user_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
         except AvatarsimError as exc:
             err_console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
             raise typer.Exit(2) from None
+        except (typer.Exit, typer.Abort, KeyboardInterrupt):
+            raise
+        except Exception as exc:
+            if os.environ.get("AVATARSIM_DEBUG") == "1":
+                raise
+            err_console.print(
+                f"[bold red]internal error:[/] {type(exc).__name__}: {exc} "
+                "(a bug in avatarsim; rerun with AVATARSIM_DEBUG=1 for the traceback)",
+                highlight=False,
+                soft_wrap=True,
+            )
+            raise typer.Exit(INTERNAL_ERROR) from None
 
     return wrapper
 

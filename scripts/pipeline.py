@@ -7,6 +7,9 @@ runs, and nothing is written for a scenario that does not validate.
 
 from __future__ import annotations
 
+import os
+import shutil
+import tempfile
 import time
 from pathlib import Path
 from typing import Any
@@ -22,6 +25,11 @@ from scripts.stages import STAGES, physics
 METRICS: dict[str, str] = {k: v for stage in STAGES for k, v in stage.METRICS.items()}
 
 
+def produced_metrics(stage, scenario: Scenario) -> set[str]:
+    """The metrics ``stage`` produces for ``scenario`` (all of its ``METRICS`` unless it says)."""
+    return stage.metrics_for(scenario) if hasattr(stage, "metrics_for") else set(stage.METRICS)
+
+
 def validate(scenario: Scenario) -> None:
     """Everything about a scenario that can be checked before running it."""
     physics_keys = set(physics.METRICS)
@@ -32,6 +40,13 @@ def validate(scenario: Scenario) -> None:
     if unknown:
         raise ScenarioError(
             f"thresholds name unknown metric(s) {unknown}; known: {sorted(METRICS)}"
+        )
+    produced = set().union(*(produced_metrics(stage, scenario) for stage in STAGES))
+    idle = sorted(set(scenario.thresholds) - produced)
+    if idle:
+        raise ScenarioError(
+            f"thresholds name metric(s) {idle} that this scenario does not produce "
+            "(enable the stage or method that measures them)"
         )
     try:
         physics.config(scenario.physics)
@@ -45,8 +60,24 @@ def run_scenario(
     """Run every stage, evaluate thresholds, write results.json and junit.xml into ``out_dir``."""
     validate(scenario)
     console = console or Console(stderr=True)
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
+    final_dir = Path(out_dir)
+    final_dir.parent.mkdir(parents=True, exist_ok=True)
+    # Stages write into a hidden sibling folder that replaces ``out_dir`` only when the run
+    # completes, so a failed run never leaves half its outputs behind.
+    out_dir = Path(tempfile.mkdtemp(dir=final_dir.parent, prefix=f".{final_dir.name}.partial-"))
+    try:
+        results = _run_stages(scenario, out_dir, console)
+    except BaseException:
+        shutil.rmtree(out_dir, ignore_errors=True)
+        raise
+    if final_dir.exists():
+        shutil.rmtree(final_dir)
+    os.replace(out_dir, final_dir)
+    final_dir.chmod(0o755)
+    return results
+
+
+def _run_stages(scenario: Scenario, out_dir: Path, console: Console) -> dict[str, Any]:
     ctx = RunContext(scenario, out_dir, console)
     timings: dict[str, float] = {}
     start = time.perf_counter()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 import os
 import platform
 import tempfile
@@ -11,6 +12,8 @@ from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 from scripts.scenario import Threshold
 
@@ -63,8 +66,26 @@ def write_atomic(path: Path, data: bytes | str) -> Path:
     return path
 
 
+def _plain(value: Any) -> Any:
+    """JSON-safe: numpy scalars and arrays as Python values, NaN/inf as null (strict JSON)."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return _plain(value.tolist())
+    if isinstance(value, np.bool_ | bool):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating | float):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
 def write_json(path: Path, payload: dict[str, Any]) -> Path:
-    return write_atomic(path, json.dumps(payload, indent=2, sort_keys=False, default=float) + "\n")
+    text = json.dumps(_plain(payload), indent=2, allow_nan=False, default=str)
+    return write_atomic(path, text + "\n")
 
 
 def junit_xml(suite: str, checks: list[CheckResult], time_s: float = 0.0) -> str:

@@ -163,9 +163,14 @@ def _section(cls: type, table: Any, where: str) -> Any:
 
 def _threshold(name: str, raw: Any) -> Threshold:
     if isinstance(raw, int | float) and not isinstance(raw, bool):
+        if raw != raw or raw in (float("inf"), float("-inf")):
+            raise ScenarioError(f"thresholds.{name} must be a finite number, got {raw!r}")
         return Threshold(max=float(raw))
     if isinstance(raw, dict) and raw and set(raw) <= {"min", "max"}:
         t = _section(Threshold, raw, f"thresholds.{name}")
+        bounds = [b for b in (t.min, t.max) if b is not None]
+        if any(b != b or abs(b) == float("inf") for b in bounds):
+            raise ScenarioError(f"thresholds.{name} bounds must be finite numbers")
         return t
     raise ScenarioError(f"thresholds.{name} must be a number (max) or a table {{min=, max=}}")
 

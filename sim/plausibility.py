@@ -100,7 +100,13 @@ class PlausibilityReport:
             if key in self.values:
                 value, limit = self.values[key], getattr(self.config, key)
                 rows.append(
-                    dict(name=key, check=check, value=value, threshold=limit, passed=value <= limit)
+                    dict(
+                        name=key,
+                        check=check,
+                        value=float(value),
+                        threshold=float(limit),
+                        passed=bool(value <= limit),
+                    )
                 )
         return rows
 

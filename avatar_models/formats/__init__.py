@@ -20,6 +20,8 @@ def load_motion(path: str | Path, **options) -> Motion:
     """Read a motion file. ``options`` go to the format's reader (e.g. ``unit=``, ``asf=``)."""
     path = Path(path)
     suffix = path.suffix.lower()
+    if path.is_dir():
+        raise MotionFormatError("is a directory, not a motion file", path)
     if not path.is_file():
         raise MotionFormatError("no such file", path)
     if suffix == ".bvh":
@@ -33,15 +35,28 @@ def load_motion(path: str | Path, **options) -> Motion:
     if suffix == ".npz":
         from avatar_models.formats.npz import read_npz
 
-        return read_npz(path, **options)
+        if options:
+            raise MotionFormatError(
+                f"NPZ files are always metres, Z up; options {sorted(options)} do not apply", path
+            )
+        return read_npz(path)
     raise MotionFormatError(
         f"unknown motion format {suffix!r}; readable: {', '.join(READABLE)}", path
     )
 
 
 def save_motion(motion: Motion, path: str | Path, **options) -> Path:
-    """Write ``motion`` to ``path`` (by extension), atomically (temp file then rename)."""
-    path = Path(path)
+    """Write ``motion`` to ``path`` (by extension), atomically (temp file then rename).
+
+    A folder that cannot be created or written raises :class:`MotionFormatError`.
+    """
+    try:
+        return _save_motion(motion, Path(path), **options)
+    except OSError as exc:
+        raise MotionFormatError(f"cannot write: {exc.strerror or exc}", path) from exc
+
+
+def _save_motion(motion: Motion, path: Path, **options) -> Path:
     suffix = path.suffix.lower()
     if suffix == ".bvh":
         from avatar_models.formats.bvh import write_bvh

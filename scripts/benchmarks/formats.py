@@ -11,9 +11,8 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
-import numpy as np
-
 from avatar_models.formats.bvh import read_bvh, write_bvh
+from avatar_models.generator import generate
 from scripts.benchmarks import BenchRow, best_of
 
 MOCAP_DIR = Path(__file__).resolve().parents[2].parent / "shared" / "mocap"
@@ -21,12 +20,9 @@ REAL_CLIPS = ("cmu/125_01.bvh", "bandai/dataset-1/data/dataset-1_walk_normal_001
 
 
 def _generated_clip(folder: Path) -> Path:
-    from tests.avatar_models.test_bvh import random_motion  # test helper, benchmark-only use
-
-    motion = random_motion(np.random.default_rng(0), n_joints=31, n_frames=600)
-    return write_bvh(
-        motion.translated(np.array([0.0, 0.0, 1.0])), folder / "generated.bvh", unit="cm"
-    )
+    """A built-in walk at 120 fps (the CMU rate), 5 s, as BVH in centimetres."""
+    motion = generate("walk", duration_s=5.0, fps=120.0, seed=0)
+    return write_bvh(motion, folder / "generated.bvh", unit="cm")
 
 
 def _bvhio_fk(root, frames: int) -> None:

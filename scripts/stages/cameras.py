@@ -13,6 +13,7 @@ from render_cams.kinect.depth import colourise, read_depth_png
 from render_cams.kinect.sensors import get_sensor
 from scripts.results import write_atomic
 from scripts.run_context import RunContext
+from scripts.scenario import Scenario
 
 METRICS = {
     "fisheye_fps_rendered": "fisheye camera frames rendered per second (all cameras)",
@@ -20,6 +21,14 @@ METRICS = {
 }
 WINDOW_S = 0.1  # a few frames at the cameras' 30 Hz, mid-clip
 PANEL_H = 240
+
+
+def metrics_for(scenario: Scenario) -> set[str]:
+    spec = scenario.cameras
+    if spec is None:
+        return set()
+    wanted = {"fisheye_fps_rendered": spec.fisheye, "kinect_fps_rendered": spec.kinect}
+    return {name for name, on in wanted.items() if on}
 
 
 def window(ctx: RunContext):

@@ -5,12 +5,17 @@ from __future__ import annotations
 from render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
 from render_cams.vr.noise import Drift, Latency, PositionJitter, RotationJitter
 from scripts.run_context import RunContext
+from scripts.scenario import Scenario
 
 METRICS = {"vr_valid_frac": "share of valid VR samples over all devices"}
 
 # Lighthouse-grade jitter and drift (render_cams.vr.noise defaults) and one 90 Hz frame of
 # tracking latency; latency first, since it shifts whole samples.
 REALISTIC_NOISE = (Latency(seconds=1 / 90), PositionJitter(), RotationJitter(), Drift())
+
+
+def metrics_for(scenario: Scenario) -> set[str]:
+    return set(METRICS) if scenario.devices is not None and scenario.devices.vr else set()
 
 
 def setup(ctx: RunContext) -> VRSetup:

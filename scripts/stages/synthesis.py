@@ -9,7 +9,7 @@ from avatar_models.generator import generate, sample_subject
 from avatar_models.measure import standing_height
 from avatar_models.motion import Motion
 from scripts.run_context import RunContext
-from scripts.scenario import ScenarioError
+from scripts.scenario import Scenario, ScenarioError
 from sim.plausibility import check_motion
 from synthesis.base import Synthesizer
 from synthesis.coolmoves import CoolMoves, Options, build_database
@@ -37,6 +37,11 @@ METRICS = {
         for m in METHODS
     },
 }
+
+
+def metrics_for(scenario: Scenario) -> set[str]:
+    methods = scenario.synthesis.methods if scenario.synthesis is not None else ()
+    return {name for name in METRICS if name.split("_", 1)[0] in methods}
 
 
 def database_takes(ctx: RunContext) -> list[Motion]:

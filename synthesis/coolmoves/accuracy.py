@@ -1,5 +1,5 @@
-"""Accuracy of a synthesiser as CoolMoves §4.1 measures it, and the cross-subject protocol on
-the built-in generator.
+"""Accuracy of a synthesiser as CoolMoves §4.1 measures it (the protocols that use it live in
+:mod:`synthesis.evaluate`).
 
 - Error: mean Euclidean distance (cm) between output and ground-truth ``body17`` joints,
   grouped as the paper groups them (hands; upper body = head, neck, arms; lower body =
@@ -14,27 +14,21 @@ the built-in generator.
   "no correlation".
 - Both skip the first ``window - 1`` frames (89 ms), before the first full window exists,
   when any window-based method can only show a default pose.
-- Cross-subject (§4.1.1): per activity, the database holds every other subject's take and the
-  held-out subject is synthesised from its simulated headset and controllers.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
 import numpy as np
 
 from avatar_models import Motion, body17
-from avatar_models.generator import generate, sample_subject
 from avatar_models.rigs import body17_positions
 from render_cams import TrackingStream, VRSetup
 from render_cams.device import motion_at_rate
-from synthesis.base import Synthesizer, on_clock, usable_mask
+from synthesis.base import SynthesisError, Synthesizer, on_clock, usable_mask
 from synthesis.coolmoves import foot_contact
 from synthesis.coolmoves.correlation import pearson
-from synthesis.coolmoves.database import HANDS_DRIVE, Drivers, build_database, driver_positions
+from synthesis.coolmoves.database import HANDS_DRIVE, Drivers, driver_positions
 from synthesis.coolmoves.features import WINDOW_SAMPLES
-from synthesis.coolmoves.synthesizer import CoolMoves, Options
 
 PAPER_ACTIVITIES = ("box", "dribble", "climb_ladder", "run", "swim")
 """The generator's counterparts of the paper's Table 1 (boxing, basketball, climbing a ladder,
@@ -73,6 +67,11 @@ def hand_correlation(
     n = min(output.n_frames, clocked.n_samples)
     ok = ok[:n].copy()
     ok[:skip] = False
+    if ok.sum() < 3:
+        raise SynthesisError(
+            f"hand correlation needs at least 3 tracked frames after the first {skip} "
+            f"(window warm-up); this stream has {int(ok.sum())}: use a longer clip"
+        )
     given = clocked.positions[:n, idx[1:]] - clocked.positions[:n, idx[:1]]
     head, sides = driver_positions(output[:n], drivers)
     produced = sides - head[:, None]
@@ -102,46 +101,4 @@ def evaluate(
         "err_cm": body17_errors_cm(output, truth),
         "hand_corr": hand_correlation(output, stream),
         "frames": output.n_frames,
-    }
-
-
-def cross_subject_generated(
-    activities: Sequence[str] = PAPER_ACTIVITIES,
-    n_subjects: int = 5,
-    duration_s: float = 8.0,
-    seed: int = 0,
-    options: Options | None = None,
-    setup: VRSetup | None = None,
-) -> dict:
-    """Leave-one-subject-out accuracy of CoolMoves on generated subjects, per activity.
-
-    Returns ``{"per_activity": {activity: {"err_cm": {...}, "hand_corr": {...}}},
-    "overall": {...}, "seed": seed}``; overall values are means over activities.
-    """
-    rng = np.random.default_rng(seed)
-    subjects = [sample_subject(rng) for _ in range(n_subjects)]
-    seeds = rng.integers(0, 2**31 - 1, size=(n_subjects, len(activities)))
-    per_activity = {}
-    for k, activity in enumerate(activities):
-        takes = [
-            generate(activity, s, duration_s, 90.0, int(seeds[i, k]))
-            for i, s in enumerate(subjects)
-        ]
-        folds = []
-        for held in range(n_subjects):
-            database = build_database([m for i, m in enumerate(takes) if i != held])
-            synth = CoolMoves(database, subjects[held].height_m, options)
-            folds.append(evaluate(synth, takes[held], setup, seed=int(seeds[held, k])))
-        per_activity[activity] = _mean(folds)
-    return {
-        "per_activity": per_activity,
-        "overall": _mean(list(per_activity.values())),
-        "seed": seed,
-    }
-
-
-def _mean(results: list[dict]) -> dict:
-    return {
-        key: {g: float(np.mean([r[key][g] for r in results])) for g in results[0][key]}
-        for key in ("err_cm", "hand_corr")
     }

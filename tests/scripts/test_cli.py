@@ -49,3 +49,47 @@ def test_threshold_on_unknown_metric_exits_2(tmp_path):
 def test_unknown_benchmark_exits_2():
     result = runner.invoke(app, ["bench", "nope"])
     assert result.exit_code == 2 and "unknown benchmark" in result.stderr
+
+
+def test_npz_takes_no_unit_and_directories_are_named(tmp_path):
+    from avatar_models.formats import save_motion
+    from avatar_models.generator import generate
+
+    npz = save_motion(generate("wave", duration_s=0.2), tmp_path / "w.npz")
+    result = runner.invoke(app, ["info", str(npz), "--unit", "cm"])
+    assert result.exit_code == 2 and "NPZ files are always metres" in result.stderr
+    result = runner.invoke(app, ["info", str(tmp_path)])
+    assert result.exit_code == 2 and "is a directory" in result.stderr
+
+
+def test_convert_to_an_unwritable_place_exits_2(tmp_path):
+    from avatar_models.formats import save_motion
+    from avatar_models.generator import generate
+
+    npz = save_motion(generate("wave", duration_s=0.2), tmp_path / "w.npz")
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    result = runner.invoke(app, ["convert", str(npz), str(blocker / "sub" / "out.bvh")])
+    assert result.exit_code == 2 and "cannot write" in result.stderr
+
+
+def test_threshold_on_a_metric_the_scenario_does_not_produce_exits_2(tmp_path):
+    sc = tmp_path / "s.toml"
+    sc.write_text("[thresholds]\ncoolmoves_err_cm_full = 9.0\n")  # no [synthesis] table
+    out = tmp_path / "o"
+    result = runner.invoke(app, ["run", str(sc), "--out", str(out)])
+    assert result.exit_code == 2 and "does not produce" in result.stderr
+    assert not out.exists() and not list(tmp_path.glob(".o.partial-*"))
+
+
+def test_a_bug_exits_3_not_1(monkeypatch, tmp_path):
+    import avatar_models.formats as formats
+
+    def broken(*args, **kwargs):
+        raise ZeroDivisionError("boom")
+
+    monkeypatch.setattr(formats, "load_motion", broken)
+    f = tmp_path / "a.bvh"
+    f.write_text("HIERARCHY\n")
+    result = runner.invoke(app, ["info", str(f)])
+    assert result.exit_code == 3 and "internal error" in result.stderr

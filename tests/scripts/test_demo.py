@@ -34,7 +34,7 @@ def test_results_follow_the_contract(short_run):
     names = {c["name"] for c in on_disk["checks"]}
     assert {"replay_error_mm_max", "penetration_cm_p95", "skate_cm_s_median"} <= names
     for c in on_disk["checks"]:
-        assert set(c) == {"name", "value", "threshold", "passed"}
+        assert {"name", "value", "threshold", "passed"} <= set(c)
     assert on_disk["motion"]["frames"] == 136  # 1.5 s at 90 fps, both ends included
     root = ET.parse(out / "junit.xml").getroot()
     assert int(root.get("tests")) == len(on_disk["checks"])

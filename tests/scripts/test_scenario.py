@@ -68,3 +68,23 @@ def test_junit_xml_marks_failures():
     cases = {c.get("name"): c for c in root.iter("testcase")}
     assert cases["a"].find("failure") is None
     assert "2" in cases["b"].find("failure").get("message")
+
+
+def test_results_json_is_strict_json(tmp_path):
+    import json
+    import math
+
+    import numpy as np
+
+    from scripts.results import write_json
+
+    path = write_json(
+        tmp_path / "r.json", {"a": np.float64("nan"), "ok": np.bool_(True), "n": np.int64(3)}
+    )
+    data = json.loads(path.read_text(), parse_constant=lambda c: math.nan)  # would see NaN
+    assert data == {"a": None, "ok": True, "n": 3}
+
+
+def test_non_finite_thresholds_are_rejected():
+    with pytest.raises(ScenarioError, match="finite"):
+        parse_scenario({"thresholds": {"frames": float("nan")}})

@@ -158,3 +158,11 @@ def test_alignment_helps_a_user_facing_another_way(small_db, test_motion):
         return body17_errors_cm(CoolMoves(small_db, height, opts).run(turned_stream), truth)["full"]
 
     assert full_error(True) < full_error(False) - 2.0
+
+
+def test_hand_correlation_of_a_too_short_clip_is_a_clear_error(small_db, test_motion):
+    short = test_motion[:6]  # shorter than the 9-sample window warm-up
+    short_stream = VRSetup().sample(short, seed=0)
+    output = CoolMoves(small_db, TEST_SUBJECT.height_m).run(short_stream)
+    with pytest.raises(SynthesisError, match="at least 3 tracked frames"):
+        hand_correlation(output, short_stream)
