@@ -8,7 +8,10 @@ pitched up (ring) or down (grip) by 32.5 deg, with the image's x axis along the 
 +Y, so the image is upright when the controller is held level. Mounting offsets in the
 controller frame (+X pointing, +Y left, +Z up; see :mod:`render_cams.vr.placements`) are
 plausible values for a Quest 2 controller chosen here, not measurements: the ring 6 cm above
-and 2 cm in front of the palm centre, the grip's bottom 8 cm below and 2 cm behind it.
+and 2 cm in front of the palm centre, the grip's bottom 6 cm below and 2 cm behind it (the
+palm closes round the middle of a grip about 11 cm long). A mount 8 cm below put the camera
+inside the chest in a boxing guard and inside the hip in a short runner's arm swing, where
+a real controller merely touches the body.
 
 Camera poses ride on the controller pose of :mod:`render_cams.vr`: a camera is an
 :class:`~render_cams.vr.Attachment` composed of the controller's grip and the mount.
@@ -29,7 +32,7 @@ COMPOSITE_VERTICAL_FOV_DEG = 185.0  # ControllerPose §4.1
 CAMERA_VERTICAL_FOV_DEG = 120.0  # ControllerPose §4.1
 PITCH_RAD = np.radians(0.5 * (COMPOSITE_VERTICAL_FOV_DEG - CAMERA_VERTICAL_FOV_DEG))
 RING_OFFSET_M = np.array([0.02, 0.0, 0.06])
-GRIP_BOTTOM_OFFSET_M = np.array([-0.02, 0.0, -0.08])
+GRIP_BOTTOM_OFFSET_M = np.array([-0.02, 0.0, -0.06])
 CONTROLLERS = ("left_controller", "right_controller")
 
 
