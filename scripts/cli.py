@@ -25,8 +25,8 @@ from scripts.cli_common import (
     console,
     emit_json,
     err_console,
+    load_motion_arg,
     make_app,
-    unit_option,
     user_errors,
 )
 
@@ -36,7 +36,9 @@ app = make_app()
 @app.command()
 @user_errors
 def info(
-    motion: Annotated[Path, typer.Argument(help="A .bvh, .amc (ASF beside it) or .npz file.")],
+    motion: Annotated[
+        str, typer.Argument(help="A .bvh, .amc (ASF beside it) or .npz file, or builtin:ACTIVITY.")
+    ],
     unit: Annotated[
         str | None, typer.Option(help="File unit: cm, inch, m, cmu or metres per unit.")
     ] = None,
@@ -44,10 +46,9 @@ def info(
     json_out: JsonOpt = None,
 ) -> None:
     """Skeleton, fps, frames and size of a motion file."""
-    from avatar_models.formats import load_motion
     from avatar_models.measure import standing_height
 
-    m = load_motion(motion, **unit_option(unit))
+    m = load_motion_arg(motion, unit, seed)
     payload = {
         "path": str(motion),
         "joints": m.skeleton.n_joints,
@@ -57,7 +58,7 @@ def info(
         "duration_s": m.duration_s,
         "height_m": standing_height(m),
     }
-    table = Table(title=motion.name, show_header=False)
+    table = Table(title=Path(motion).name, show_header=False)
     for key in ("joints", "fps", "frames", "duration_s", "height_m"):
         value = payload[key]
         table.add_row(key, f"{value:.3f}" if isinstance(value, float) else str(value))
@@ -68,7 +69,7 @@ def info(
 @app.command()
 @user_errors
 def convert(
-    src: Annotated[Path, typer.Argument(help="Input .bvh, .amc or .npz.")],
+    src: Annotated[str, typer.Argument(help="Input .bvh, .amc or .npz, or builtin:ACTIVITY.")],
     dst: Annotated[Path, typer.Argument(help="Output .bvh or .npz.")],
     fps: Annotated[float | None, typer.Option(help="Resample to this frame rate.")] = None,
     unit: Annotated[str | None, typer.Option(help="Input unit (see `info`).")] = None,
@@ -76,9 +77,9 @@ def convert(
     json_out: JsonOpt = None,
 ) -> None:
     """Convert BVH / ASF+AMC / NPZ to BVH or NPZ, optionally resampled."""
-    from avatar_models.formats import load_motion, save_motion
+    from avatar_models.formats import save_motion
 
-    m = load_motion(src, **unit_option(unit))
+    m = load_motion_arg(src, unit, seed)
     if fps is not None:
         m = m.resample(fps)
     save_motion(m, dst)

@@ -83,6 +83,17 @@ class _Tokens:
         self.pos += 1
         return item
 
+    def name(self, what: str, keyword_line: int) -> str:
+        """The rest of the keyword's line as one name: rigs such as 3ds Max Biped use names
+        with spaces (``JOINT Bip01 L Thigh``)."""
+        parts = []
+        while self.pos < len(self.items) and self.items[self.pos][1] == keyword_line:
+            parts.append(self.items[self.pos][0])
+            self.pos += 1
+        if not parts:
+            raise self.error(f"{what} is missing after the keyword", keyword_line)
+        return " ".join(parts)
+
     def expect(self, word: str) -> int:
         tok, line = self.next(repr(word))
         if tok != word:
@@ -132,7 +143,7 @@ def _parse_hierarchy(text: str, path: Path) -> list[_Joint]:
     tok = _Tokens(text, path)
     tok.expect("HIERARCHY")
     line = tok.expect("ROOT")
-    joints = [_parse_joint_header(tok, tok.next("root name")[0], -1, line)]
+    joints = [_parse_joint_header(tok, tok.name("root name", line), -1, line)]
     names = {joints[0].name}
     open_joints = [0]
     while open_joints:
@@ -140,7 +151,7 @@ def _parse_hierarchy(text: str, path: Path) -> list[_Joint]:
         if word == "}":
             open_joints.pop()
         elif word == "JOINT":
-            name = tok.next("joint name")[0]
+            name = tok.name("joint name", line)
             if name in names or name in "{}":
                 raise tok.error(f"duplicate or invalid joint name {name!r}", line)
             joints.append(_parse_joint_header(tok, name, open_joints[-1], line))

@@ -13,14 +13,17 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from scripts.cli_common import JsonOpt, SeedOpt, console, emit_json, unit_option, user_errors
+from scripts.cli_common import JsonOpt, SeedOpt, console, emit_json, load_motion_arg, user_errors
 
 
 def register(app: typer.Typer) -> None:
     @app.command()
     @user_errors
     def check(
-        motion: Annotated[Path, typer.Argument(help="A .bvh, .amc (ASF beside it) or .npz file.")],
+        motion: Annotated[
+            str,
+            typer.Argument(help="A .bvh, .amc (ASF beside it) or .npz file, or builtin:ACTIVITY."),
+        ],
         out: Annotated[Path, typer.Option(help="Folder for CSV, JSON and plot.")] = Path(
             "out/check"
         ),
@@ -35,13 +38,12 @@ def register(app: typer.Typer) -> None:
         json_out: JsonOpt = None,
     ) -> None:
         """Physics plausibility of a motion on the MuJoCo humanoid. Exit 1 if a check fails."""
-        from avatar_models.formats import load_motion
         from sim.plausibility import body_and_motion, check_motion
         from sim.report import summary_rows, write_outputs
         from sim.thresholds import CheckConfig
 
         cfg = CheckConfig.from_toml(config) if config is not None else CheckConfig()
-        m = load_motion(motion, **unit_option(unit))
+        m = load_motion_arg(motion, unit, seed)
         body, m = body_and_motion(m, None)
         report = check_motion(m, body, cfg)
         report.meta.update(path=str(motion), seed=seed)

@@ -292,3 +292,17 @@ def test_fast_and_checked_frame_parsers_agree_bit_for_bit(tmp_path, fmt, newline
     checked = _checked_motion_values(data, 40, 9, tmp_path / "x.bvh", 1)
     assert fast.tobytes() == checked.tobytes()
     np.testing.assert_allclose(fast, values, rtol=1e-2 if fmt == "%.3e" else 1e-5, atol=1e-5)
+
+
+def test_joint_names_with_spaces_round_trip(tmp_path):
+    """The avatar rig is a 3ds Max Biped: 'Bip01 L Thigh' must survive write -> read."""
+    from avatar_models.generator import generate
+
+    motion = generate("wave", duration_s=0.3, fps=30.0)
+    back = read_bvh(write_bvh(motion, tmp_path / "biped.bvh"))
+    assert "Bip01 L Thigh" in back.skeleton.names
+    np.testing.assert_allclose(
+        back.positions_of(["Bip01 L Thigh", "Bip01 R Hand"]),
+        motion.positions_of(["Bip01 L Thigh", "Bip01 R Hand"]),
+        atol=1e-6,
+    )

@@ -93,3 +93,16 @@ def test_a_bug_exits_3_not_1(monkeypatch, tmp_path):
     f.write_text("HIERARCHY\n")
     result = runner.invoke(app, ["info", str(f)])
     assert result.exit_code == 3 and "internal error" in result.stderr
+
+
+def test_builtin_motions_work_wherever_a_motion_file_does(tmp_path):
+    info = runner.invoke(app, ["info", "builtin:squat", "--json", str(tmp_path / "i.json")])
+    assert info.exit_code == 0, info.output
+    out = tmp_path / "kick.bvh"
+    assert runner.invoke(app, ["convert", "builtin:kick", str(out), "--fps", "30"]).exit_code == 0
+    # The written BVH reads back as the generated motion's frame count at 30 fps (4 s).
+    back = runner.invoke(app, ["info", str(out), "--json", str(tmp_path / "k.json")])
+    assert back.exit_code == 0
+    import json
+
+    assert json.loads((tmp_path / "k.json").read_text())["frames"] == 121
