@@ -41,7 +41,13 @@ from render_cams.fisheye.keypoints import (
 from render_cams.fisheye.model import FisheyeModel
 from render_cams.fisheye.records import frame_record
 from render_cams.fisheye.render import FisheyeRenderer
-from render_cams.fisheye.rig import camera_poses, check_cameras_outside, controller_cameras
+from render_cams.fisheye.rig import (
+    ControllerCamera,
+    camera_poses,
+    check_cameras_outside,
+    controller_cameras,
+)
+from render_cams.fisheye.stitch import stitch_params
 from render_cams.scene import BodyScene
 
 CAMERA_RATE_HZ = 30.0
@@ -58,6 +64,7 @@ def render_fisheye_sequence(
     detector_noise: DetectorNoise | None = None,
     controllers: Sequence[str] = ("left_controller", "right_controller"),
     video: bool = True,
+    stitch: bool = True,
 ) -> dict:
     """Render every controller camera over ``motion`` into ``out_dir``; return a summary
     ``{"frames", "cameras", "fps_rendered", "bad_frames", "seed", "out_dir"}``.
@@ -151,6 +158,8 @@ def render_fisheye_sequence(
         "fps_rendered": n_frames * n_cams / max(elapsed, 1e-9),
         "out_dir": str(out),
     }
+    if stitch:
+        summary["stitched"] = _write_stitched(model, cameras, images, out)
     if video:
         tiled = np.concatenate(
             [np.concatenate(list(images[r : r + 2]), axis=2) for r in range(0, n_cams, 2)], axis=1
@@ -164,3 +173,28 @@ def render_fisheye_sequence(
         )
         summary["video"] = str(out / "fisheye.mp4")
     return summary
+
+
+def _write_stitched(
+    model: FisheyeModel,
+    cameras: Sequence[ControllerCamera],
+    images: np.ndarray,
+    out: Path,
+) -> list[str]:
+    """Each controller's two cameras stitched onto one cylinder (ControllerPose §4.2) per
+    frame, from stitch parameters computed once per controller: ``stitched/<controller>/``."""
+    folders = []
+    by_controller: dict[str, list[int]] = {}
+    for c, camera in enumerate(cameras):
+        by_controller.setdefault(camera.controller, []).append(c)
+    for controller, pair in by_controller.items():
+        if len(pair) != 2:
+            continue
+        params = stitch_params(model, [cameras[c] for c in pair])
+        folder = out / "stitched" / controller
+        folder.mkdir(parents=True, exist_ok=True)
+        for t in range(images.shape[1]):
+            composite = params.stitch([images[c, t] for c in pair])
+            cv2.imwrite(str(folder / f"{t:06d}.png"), composite[..., ::-1])
+        folders.append(str(folder.relative_to(out)))
+    return folders

@@ -24,6 +24,10 @@ def test_sequence_files_and_records_reproject_with_opencv(tmp_path):
     image = cv2.imread(str(tmp_path / summary["cameras"][0] / "000003.png"))
     range_mm = cv2.imread(str(tmp_path / summary["cameras"][0] / "000003_range.png"), -1)
     assert image.shape == (60, 80, 3) and range_mm.dtype == np.uint16
+    # One stitched composite per controller and frame (two cameras -> one cylinder).
+    assert summary["stitched"] == ["stitched/left_controller", "stitched/right_controller"]
+    composites = sorted((tmp_path / "stitched" / "left_controller").glob("*.png"))
+    assert len(composites) == 10 and cv2.imread(str(composites[0])).mean() > 0
     data = json.loads((tmp_path / "keypoints.json").read_text())
     assert data["seed"] == 5 and len(data["records"]) == 40
     record = data["records"][7]
