@@ -3,8 +3,6 @@ PY ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
-export MUJOCO_GL ?= egl
-export PYOPENGL_PLATFORM ?= egl
 OUT ?= out/demo
 
 .PHONY: demo test lint bench clean
