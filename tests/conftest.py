@@ -7,8 +7,7 @@ from pathlib import Path
 
 import pytest
 
-os.environ.setdefault("MUJOCO_GL", "egl")
-os.environ.setdefault("PYOPENGL_PLATFORM", "egl")
+import avatar_models  # noqa: F401  (picks the headless GL backend before any GL import)
 
 MOCAP_DIR = Path(
     os.environ.get(
