@@ -61,8 +61,10 @@ def run(ctx: RunContext) -> None:
         folder = ctx.out_dir / "cameras" / "fisheye"
         summary = render_fisheye_sequence(clip, folder, seed=ctx.scenario.seed, video=False)
         ctx.metrics["fisheye_fps_rendered"] = float(summary["fps_rendered"])
-        for cam in sorted(p for p in folder.iterdir() if p.is_dir()):
-            panels.append(panel(iio.imread(cam / "000000.png"), cam.name))
+        for name in summary["cameras"]:
+            panels.append(panel(iio.imread(folder / name / "000000.png"), name))
+        for stitched in summary.get("stitched", []):
+            panels.append(panel(iio.imread(folder / stitched / "000000.png"), stitched))
         ctx.output("fisheye_keypoints", folder / "keypoints.json")
     if spec.kinect:
         from render_cams.kinect.sequence import render_kinect_sequence
