@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.generator import generate, sample_subject
+from avatar_models.generator import generate_library
 from avatar_models.measure import standing_height
 from avatar_models.motion import Motion
 from scripts.run_context import RunContext
@@ -47,14 +47,12 @@ def metrics_for(scenario: Scenario) -> set[str]:
 def database_takes(ctx: RunContext) -> list[Motion]:
     """Built-in takes of the scenario's activity by other subjects (not the user)."""
     spec = ctx.scenario.synthesis
-    rng = np.random.default_rng([ctx.scenario.seed, 1])  # a stream apart from the user's
+    # A seed stream apart from the user's (the user is the first subject of the scenario seed).
+    seed = int(np.random.SeedSequence([ctx.scenario.seed, 1]).generate_state(1)[0])
     activity = ctx.info["motion"]["activity"] or "walk"
-    return [
-        generate(
-            activity, sample_subject(rng), spec.database_duration_s, 90.0, int(rng.integers(2**31))
-        )
-        for _ in range(spec.database_subjects)
-    ]
+    return generate_library(
+        (activity,), spec.database_subjects, spec.database_duration_s, 90.0, seed
+    )
 
 
 def make_synthesizer(method: str, ctx: RunContext, user_height_m: float) -> Synthesizer:
