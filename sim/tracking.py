@@ -261,6 +261,47 @@ def _yaw_quat(angle: float, quats: np.ndarray) -> np.ndarray:
     return out
 
 
+@dataclass(frozen=True)
+class Reference:
+    """A reference motion prepared for tracking (:meth:`Tracker.reference`).
+
+    Attributes:
+        qpos: ``(T, nq)`` configurations at ``fps``.
+        forward: ``(T, nv)`` velocity from each frame to the next (interpolation).
+        qvel, qacc: ``(T, nv)`` smoothed velocities and accelerations.
+        swing: ``(T, 2)`` foot-placement weights (:meth:`Tracker.swing_weights`).
+        sites: ``(T, 17, 3)`` body17 site positions.
+        com: ``(T, 3, 3)`` whole-body centre of mass position, velocity, acceleration.
+    """
+
+    qpos: np.ndarray
+    forward: np.ndarray
+    qvel: np.ndarray
+    qacc: np.ndarray
+    swing: np.ndarray
+    sites: np.ndarray
+    com: np.ndarray
+    fps: float
+
+
+@dataclass(frozen=True)
+class Progress:
+    """The controller's state between simulation steps (MuJoCo's own state is in ``data``).
+
+    Attributes:
+        step: simulation steps taken.
+        clock: reference frame (fractional) played now; ``rate`` its frames per frame.
+        tau: ``(nu,)`` torques held until the next control update.
+        frames: one record per reference frame so far (:meth:`Tracker._frame_record`).
+    """
+
+    step: int
+    clock: float
+    rate: float
+    tau: np.ndarray
+    frames: list
+
+
 class Tracker:
     """A simulation of ``model`` (the humanoid MJCF) tracking references. See the module
     docstring for the controller. ``data`` is exposed so callers can inspect the state."""
@@ -278,6 +319,7 @@ class Tracker:
         model.actuator_ctrllimited[:] = 0
         self.data = mujoco.MjData(model)
         self.dof = model.jnt_dofadr[model.actuator_trnid[:, 0]]
+        self.hinge_qadr = model.jnt_qposadr[model.actuator_trnid[:, 0]]
         self.sites = np.array(
             [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, n) for n in BODY17]
         )
@@ -350,83 +392,133 @@ class Tracker:
             out[t] = data.site_xpos[sites]
         return out
 
-    def run(self, qpos_ref: np.ndarray, fps: float) -> TrackingResult:
-        """Track ``qpos_ref (T, nq)`` sampled at ``fps`` from its first frame and velocity.
-        The reference is interpolated at every control update (on the manifold)."""
+    def reference(self, qpos_ref: np.ndarray, fps: float) -> Reference:
+        """Precompute what the controller needs of ``qpos_ref (T, nq)`` sampled at ``fps``."""
         qpos_ref = np.asarray(qpos_ref, dtype=float)
-        m, d, s = self.model, self.data, self.settings
+        m, s = self.model, self.settings
         if qpos_ref.ndim != 2 or qpos_ref.shape[1] != m.nq or not np.isfinite(qpos_ref).all():
             raise MotionValueError(f"reference must be finite (T, {m.nq}), got {qpos_ref.shape}")
         if qpos_ref.shape[0] < 2:
             raise MotionValueError("reference must have at least 2 frames")
-        n = qpos_ref.shape[0]
-        forward = forward_differences(m, qpos_ref, fps)
-        qvel_ref = reference_velocities(m, qpos_ref, fps)
+        qvel = reference_velocities(m, qpos_ref, fps)
         sigma = s.smoothing_frames
         if sigma > 0:
-            qvel_ref = gaussian_filter1d(qvel_ref, sigma, axis=0, mode="nearest")
-        qacc_ref = np.gradient(qvel_ref, 1.0 / fps, axis=0)
+            qvel = gaussian_filter1d(qvel, sigma, axis=0, mode="nearest")
+        qacc = np.gradient(qvel, 1.0 / fps, axis=0)
         if sigma > 0:
-            qacc_ref = gaussian_filter1d(qacc_ref, sigma, axis=0, mode="nearest")
-        swing = self.swing_weights(qpos_ref, fps)
-        ref_sites = self.reference_sites(qpos_ref)
-        com_ref = self.reference_com(qpos_ref)
-        com_vel_ref = gaussian_filter1d(np.gradient(com_ref, 1.0 / fps, axis=0), 1.0, axis=0)
-        com_acc_ref = gaussian_filter1d(np.gradient(com_vel_ref, 1.0 / fps, axis=0), 1.0, axis=0)
+            qacc = gaussian_filter1d(qacc, sigma, axis=0, mode="nearest")
+        com = self.reference_com(qpos_ref)
+        com_vel = gaussian_filter1d(np.gradient(com, 1.0 / fps, axis=0), 1.0, axis=0)
+        com_acc = gaussian_filter1d(np.gradient(com_vel, 1.0 / fps, axis=0), 1.0, axis=0)
+        return Reference(
+            qpos=qpos_ref,
+            forward=forward_differences(m, qpos_ref, fps),
+            qvel=qvel,
+            qacc=qacc,
+            swing=self.swing_weights(qpos_ref, fps),
+            sites=self.reference_sites(qpos_ref),
+            com=np.stack([com, com_vel, com_acc], axis=1),
+            fps=fps,
+        )
 
+    def start(self, ref: Reference) -> Progress:
+        """Put the humanoid on the reference's first frame and velocity; the controller's
+        state at that moment (frame 0 recorded)."""
+        m, d = self.model, self.data
         mujoco.mj_resetData(m, d)
-        d.qpos[:], d.qvel[:] = qpos_ref[0], qvel_ref[0]
+        d.qpos[:], d.qvel[:] = ref.qpos[0], ref.qvel[0]
         mujoco.mj_step1(m, d)
         self._ref_data = mujoco.MjData(m)
-        qpos = np.empty((n, m.nq))
-        sites = np.empty((n, len(BODY17), 3))
-        torque = np.zeros((n, m.nu))
-        power = np.zeros(n)
-        qpos[0], sites[0] = d.qpos, d.site_xpos[self.sites]
-        steps = int(np.ceil((n - 1) / (fps * m.opt.timestep) - 1e-9))
-        frame_of_step = np.floor(np.arange(1, steps + 1) * m.opt.timestep * fps + 1e-9).astype(int)
+        progress = Progress(step=0, clock=0.0, rate=1.0, tau=np.zeros(m.nu), frames=[])
+        progress.frames.append(self._frame_record(0.0))
+        return progress
+
+    def steps_of(self, ref: Reference) -> int:
+        """Simulation steps that cover the reference's duration."""
+        n = ref.qpos.shape[0]
+        return int(np.ceil((n - 1) / (ref.fps * self.model.opt.timestep) - 1e-9))
+
+    def advance(
+        self,
+        ref: Reference,
+        progress: Progress,
+        steps: int,
+        target_offset: np.ndarray | None = None,
+    ) -> Progress:
+        """Simulate ``steps`` more steps from the current state; ``progress`` is the
+        controller's state there, the returned one is its state after (with the frames
+        recorded on the way). ``target_offset (nu,)`` (radians) is added to every actuated
+        hinge's target (:mod:`sim.sampling` searches over it)."""
+        m, d, s = self.model, self.data, self.settings
+        n, fps, dt = ref.qpos.shape[0], ref.fps, m.opt.timestep
         q_target = np.empty(m.nq)
-        tau = np.zeros(m.nu)
-        clock, rate = 0.0, 1.0  # reference frame index played now, frames per frame
-        reference_frame = np.zeros(n)
-        for k in range(steps):  # the simulation is sequential by nature
+        clock, rate, tau = progress.clock, progress.rate, progress.tau.copy()
+        frames = []
+        last = min(progress.step + steps, self.steps_of(ref))
+        for k in range(progress.step, last):  # the simulation is sequential by nature
             if k % s.control_period == 0:
                 phase = min(clock, n - 1.0)
                 i = min(int(phase), n - 2)
                 a = min(phase - i, 1.0)
-                q_target[:] = qpos_ref[i]
-                mujoco.mj_integratePos(m, q_target, forward[i], a / fps)
-                v_target = (1 - a) * qvel_ref[i] + a * qvel_ref[i + 1]
-                a_target = (1 - a) * qacc_ref[i] + a * qacc_ref[i + 1]
-                swinging = (1 - a) * swing[i] + a * swing[i + 1]
-                com = [(1 - a) * r[i] + a * r[i + 1] for r in (com_ref, com_vel_ref, com_acc_ref)]
+                q_target[:] = ref.qpos[i]
+                mujoco.mj_integratePos(m, q_target, ref.forward[i], a / fps)
+                v_target = (1 - a) * ref.qvel[i] + a * ref.qvel[i + 1]
+                a_target = (1 - a) * ref.qacc[i] + a * ref.qacc[i + 1]
+                swinging = (1 - a) * ref.swing[i] + a * ref.swing[i + 1]
+                com = (1 - a) * ref.com[i] + a * ref.com[i + 1]
                 self._com_jacobian()
                 error = self._capture_error(q_target, com)
                 bound = s.max_clock_change
                 rate = 1.0 + np.clip(s.clock_gain * error[0], -bound, bound)
                 self._place_feet(q_target, self._step_shift(q_target, error), swinging)
+                if target_offset is not None:
+                    q_target[self.hinge_qadr] += target_offset
                 standing = (swinging == 0) & s.level_stance_feet
                 tau = self._torques(q_target, v_target, a_target, com, standing)
             d.ctrl[:] = tau
             mujoco.mj_step2(m, d)
             mujoco.mj_step1(m, d)
-            clock += rate * m.opt.timestep * fps
-            t = frame_of_step[k]
-            if t < n and (k == 0 or frame_of_step[k - 1] != t):
-                reference_frame[t] = min(clock, n - 1.0)
-                qpos[t], sites[t] = d.qpos, d.site_xpos[self.sites]
-                torque[t] = d.actuator_force
-                power[t] = np.abs(d.actuator_force * d.qvel[self.dof]).sum()
-        ref_sites = _at_frames(ref_sites, reference_frame)
-        qpos_ref = qpos_ref[np.round(reference_frame).astype(int)]
+            clock += rate * dt * fps
+            t_prev, t = int(np.floor(k * dt * fps + 1e-9)), int(np.floor((k + 1) * dt * fps + 1e-9))
+            if t < n and t != t_prev:
+                frames.append(self._frame_record(min(clock, n - 1.0)))
+        return Progress(step=last, clock=clock, rate=rate, tau=tau, frames=progress.frames + frames)
+
+    def finished(self, ref: Reference, progress: Progress) -> bool:
+        return progress.step >= self.steps_of(ref)
+
+    def result(self, ref: Reference, frames: list[tuple]) -> TrackingResult:
+        """The :class:`TrackingResult` of the recorded ``frames`` (one per reference frame)."""
+        reference_frame, qpos, sites, torque, power = (np.array(c) for c in zip(*frames))
+        ref_sites = _at_frames(ref.sites, reference_frame)
+        qpos_ref = ref.qpos[np.round(reference_frame).astype(int)]
         return TrackingResult(
             qpos=qpos,
             body17_error=np.linalg.norm(sites - ref_sites, axis=-1),
             torque=torque,
             power=power,
             fall_frame=self._fall_frame(qpos, qpos_ref, sites, ref_sites),
-            fps=fps,
+            fps=ref.fps,
             reference_frame=reference_frame,
+        )
+
+    def run(self, qpos_ref: np.ndarray, fps: float) -> TrackingResult:
+        """Track ``qpos_ref (T, nq)`` sampled at ``fps`` from its first frame and velocity.
+        The reference is interpolated at every control update (on the manifold)."""
+        ref = self.reference(qpos_ref, fps)
+        progress = self.advance(ref, self.start(ref), self.steps_of(ref))
+        return self.result(ref, progress.frames)
+
+    def _frame_record(self, reference_frame: float) -> tuple:
+        """What is kept of the current state at a reference frame."""
+        d = self.data
+        power = np.abs(d.actuator_force * d.qvel[self.dof]).sum()
+        return (
+            reference_frame,
+            d.qpos.copy(),
+            d.site_xpos[self.sites].copy(),
+            d.actuator_force.copy(),
+            power,
         )
 
     def _com_jacobian(self):

@@ -13,8 +13,10 @@ from dataclasses import dataclass, replace
 from functools import cache
 
 import numpy as np
+from scipy.linalg import solve_banded
 
 from avatar_models.body import build_body
+from avatar_models.generator.bounce import GRAVITY_M_S2
 from avatar_models.generator.plan import Plan, Scene, realise
 from avatar_models.motion import Motion
 from avatar_models.skeleton import Skeleton
@@ -53,6 +55,27 @@ def _mass_model(skeleton: Skeleton) -> MassModel:
 def plan_centre_of_mass(scene: Scene, plan: Plan) -> np.ndarray:
     """``(T, 3)`` centre of mass of the realised ``plan``."""
     return MassModel.of(scene.skeleton).centre_of_mass(realise(scene, plan))
+
+
+def lipm_centre_of_mass(zmp: np.ndarray, height: float, fps: float) -> np.ndarray:
+    """``(T, 2)`` horizontal centre-of-mass path whose zero-moment point is ``zmp (T, 2)``
+    under the linear inverted pendulum (Kajita et al. 2003, "Biped walking pattern generation
+    by using preview control of zero-moment point"): ``zmp = c - c'' / omega^2`` with
+    ``omega = sqrt(g / height)``, second differences in time, and zero slope at both ends.
+
+    This is the one bounded solution (the ZMP smoothed by the kernel ``omega/2 exp(-omega|t|)``):
+    a centre of mass that keeps the pressure inside the feet needs no ankle torque the foot
+    cannot give, unlike a constant-speed one whose pressure point runs ahead of the toes.
+    Solved as a tridiagonal system (``scipy.linalg.solve_banded``).
+    """
+    n = zmp.shape[0]
+    k = fps * fps * height / GRAVITY_M_S2  # 1 / (omega dt)^2
+    bands = np.zeros((3, n))
+    bands[0, 1:] = -k
+    bands[2, :-1] = -k
+    bands[1] = 1.0 + 2.0 * k
+    bands[1, [0, -1]] = 1.0 + k
+    return solve_banded((1, 1), bands, zmp)
 
 
 def follow_centre_of_mass(

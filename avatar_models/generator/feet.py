@@ -150,6 +150,27 @@ def gait_track(
     )
 
 
+def centre_of_pressure(
+    scene: Scene,
+    times: np.ndarray,
+    frequency: float,
+    duty: float,
+    offset: float,
+    plant_at: Callable[[np.ndarray], np.ndarray],
+) -> tuple[np.ndarray, np.ndarray]:
+    """Where a foot of :func:`gait_track` (same arguments, at ``times (T,)`` s, which may
+    reach beyond the clip) presses on the floor while it stands: ``(T, 3)`` from the heel at heel strike to the ball at toe-off (smoothstep over
+    stance; the heel-to-toe rollover of the centre of pressure, Perry & Burnfield ch. 4), and
+    the stance progress ``(T,)`` 0..1 (NaN while the foot swings)."""
+    geom = FootGeometry.of(scene)
+    cycle, ph = phase(times, frequency, offset)
+    u = ph / duty
+    roll = smoothstep(np.clip(u, 0.0, 1.0))[:, None]
+    cop = plant_at(cycle) + geom.heel + roll * (geom.ball - geom.heel)
+    cop[:, 2] = 0.0
+    return cop, np.where(ph < duty, u, np.nan)
+
+
 def pelvis_height_limit(
     scene: Scene, root_xy: np.ndarray, trunk: np.ndarray, ankles: np.ndarray, reach: float = 0.985
 ) -> np.ndarray:

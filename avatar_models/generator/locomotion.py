@@ -7,10 +7,12 @@ Cadence and stride defaults: walking about 0.95 strides/s with a stride of 0.78 
 (about 1.35 m/s for 1.75 m; Grieve & Gear 1966, Perry & Burnfield ch. 1); running about
 1.4 strides/s with 1.3 statures per stride (about 3.2 m/s; Novacheck 1998, Gait & Posture 7).
 
-The whole-body centre of mass, not the pelvis, travels at constant forward speed, and in
-running also bounces on a spring-mass path (ballistic flights): the swinging legs carry a
-sixth of the mass each, so a pelvis at constant speed asks the floor (or, in flight, nothing)
-for their momentum changes. The running swing
+The whole-body centre of mass, not the pelvis, is planned. Walking moves it as a linear
+inverted pendulum over a zero-moment point that rolls from heel to ball of each stance foot
+(Kajita et al. 2003), so the floor can push it where it goes: a centre of mass at constant
+speed would need the pressure point up to 20 cm ahead of the toes. Running moves it at
+constant forward speed on a spring-mass path (ballistic flights). Either way the swinging
+legs, a sixth of the mass each, are accounted for: the pelvis surges against them. The running swing
 lifts the heel high behind (ankle 0.17 statures up at mid-swing: a tightly folded leg
 swings through with less inertia, Novacheck 1998) and the foot hangs toes-down from the
 flexed knee.
@@ -24,15 +26,25 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from avatar_models.generator.bounce import spring_mass_bounce, vaulting_bob
-from avatar_models.generator.com import follow_centre_of_mass, plan_centre_of_mass
-from avatar_models.generator.curves import smooth_cap
-from avatar_models.generator.feet import SWING_LIFT, gait_track, pelvis_height_limit
+from avatar_models.generator.com import (
+    follow_centre_of_mass,
+    lipm_centre_of_mass,
+    plan_centre_of_mass,
+)
+from avatar_models.generator.curves import smooth_cap, smoothstep
+from avatar_models.generator.feet import (
+    SWING_LIFT,
+    centre_of_pressure,
+    gait_track,
+    pelvis_height_limit,
+)
 from avatar_models.generator.ik import euler
 from avatar_models.generator.plan import LimbTarget, Plan, Scene
 from avatar_models.generator.poses import arm_angles, gaze, heading_rotation, trunk
 from avatar_models.generator.standing import CAP_HALF_WIDTH_S
 
 TAU = 2.0 * np.pi
+PENDULUM_PAD_S = 1.5  # exp(-omega * 1.5 s) < 1% for a centre of mass under 1.2 m
 
 
 @dataclass(frozen=True)
@@ -57,9 +69,9 @@ class Gait:
     lean: float
 
 
-# The walking heel rises by 38 deg before toe-off: with the pelvis surging over the stance foot
-# (constant-speed centre of mass), a flatter late stance dorsiflexes the ankle past the
-# humanoid's 40 deg (the IK then cannot reproduce the walk on its own rig).
+# The walking heel rises by 38 deg before toe-off: with the pelvis far over the stance foot, a
+# flatter late stance dorsiflexes the ankle past the humanoid's 40 deg (the IK then cannot
+# reproduce the walk on its own rig).
 WALK = Gait(
     0.95, 0.78, (0.85, 1.7), 0.62, 12, 38, 0.055, SWING_LIFT, 0, 0.012, 0.03, False, 5, 18, 15, 2
 )
@@ -79,7 +91,11 @@ def _gait_plan(scene: Scene, gait: Gait) -> tuple[Plan, np.ndarray]:
     swing_amp = np.radians(gait.arm_swing) * style.amplitude
     # The clip starts part-way into the gait (seeded start time); shift it to start at x = 0.
     start_x = speed * t[0]
-    tracks = []
+    tracks, pressure = [], []
+    # The walk went on before the clip and goes on after it: the pendulum's centre of mass
+    # depends on the pressure a few 1/omega (about 0.3 s) either side, so it is planned wider.
+    pad = int(round(PENDULUM_PAD_S * scene.fps))
+    padded_times = t[0] + np.arange(-pad, n + pad) / scene.fps
     for side, offset in (("L", 0.0), ("R", 0.5)):
         ankle_rest = scene.rest(f"Bip01 {side} Foot")
 
@@ -102,6 +118,9 @@ def _gait_plan(scene: Scene, gait: Gait) -> tuple[Plan, np.ndarray]:
                 gait.swing_lift,
                 np.radians(gait.swing_hang),
             )
+        )
+        pressure.append(
+            centre_of_pressure(scene, padded_times, frequency, gait.duty, offset, plant_at)
         )
     phase_l = (t * frequency) % 1.0
     mid_stance = TAU * (phase_l - gait.duty / 2)
@@ -157,23 +176,51 @@ def _gait_plan(scene: Scene, gait: Gait) -> tuple[Plan, np.ndarray]:
     if gait.running:
         plan.root_pos = _spring_mass_root(scene, plan, travel, bob, limit_of)
     else:
-        plan.root_pos = _steady_travel_root(scene, plan, travel, limit_of)
+        zmp = _zero_moment_point(pressure, gait.duty)
+        plan.root_pos = _pendulum_root(scene, plan, zmp, pad, limit_of)
     return plan, phase_l
 
 
-def _steady_travel_root(
-    scene: Scene, plan: Plan, travel: np.ndarray, limit_of: Callable[[np.ndarray], np.ndarray]
+def _zero_moment_point(pressure: list[tuple[np.ndarray, np.ndarray]], duty: float) -> np.ndarray:
+    """``(T, 2)`` wanted zero-moment point of a walk from each foot's centre of pressure and
+    stance progress (:func:`~avatar_models.generator.feet.centre_of_pressure`, left then
+    right): on the single stance foot, and in double support handed from the trailing foot
+    to the leading one (smoothstep over the ``duty - 0.5`` of a cycle both feet stand)."""
+    (cop_l, u_l), (cop_r, u_r) = pressure
+    double = max(duty - 0.5, 1e-6)
+    # Load on the left foot: 1 on it alone, 0 on the right alone, in between while it is the
+    # newly landed (rising) or the trailing (falling) foot of a double support.
+    newly_l = smoothstep(np.clip(np.nan_to_num(u_l, nan=1.0) * duty / double, 0.0, 1.0))
+    newly_r = smoothstep(np.clip(np.nan_to_num(u_r, nan=1.0) * duty / double, 0.0, 1.0))
+    both = np.isfinite(u_l) & np.isfinite(u_r)
+    leading_l = np.nan_to_num(u_l, nan=1.0) < np.nan_to_num(u_r, nan=1.0)
+    load_l = np.where(
+        both, np.where(leading_l, newly_l, 1.0 - newly_r), np.isfinite(u_l).astype(float)
+    )
+    return (load_l[:, None] * cop_l + (1.0 - load_l[:, None]) * cop_r)[:, :2]
+
+
+def _pendulum_root(
+    scene: Scene,
+    plan: Plan,
+    zmp: np.ndarray,
+    pad: int,
+    limit_of: Callable[[np.ndarray], np.ndarray],
 ) -> np.ndarray:
-    """``(T, 3)`` root positions whose centre of mass travels forward at the constant speed
-    of ``travel (T,)``: the pelvis surges against the swinging leg, so the stance foot is not
-    asked for the swing leg's horizontal force. Heights are the plan's, lowered smoothly where
-    the legs would not reach their feet (the root under ``limit_of(root_xy (T, 2)) (T,)``)."""
-    offset = plan_centre_of_mass(scene, plan)[:, 0] - plan.root_pos[:, 0]
+    """``(T, 3)`` root positions whose centre of mass is the linear inverted pendulum over
+    ``zmp (pad + T + pad, 2)`` (:func:`~avatar_models.generator.com.lipm_centre_of_mass` at the plan's
+    mean centre-of-mass height): it slows over the stance foot and speeds up between steps,
+    and sways over each foot, so the floor can give every force it needs. Heights are the
+    plan's, lowered smoothly where the legs would not reach their feet (the root under
+    ``limit_of(root_xy (T, 2)) (T,)``)."""
+    height = plan_centre_of_mass(scene, plan)[:, 2].mean()
     wanted = np.full((scene.n_frames, 3), np.nan)
-    wanted[:, 0] = travel + offset.mean()
-    root = follow_centre_of_mass(scene, plan, wanted)
-    root[:, 2] = smooth_cap(root[:, 2], limit_of(root[:, :2]), scene.fps, CAP_HALF_WIDTH_S)
-    return root
+    wanted[:, :2] = lipm_centre_of_mass(zmp, height, scene.fps)[pad : pad + scene.n_frames]
+    root = plan.root_pos
+    for _ in range(2):  # lowering the root folds the legs, which moves the centre of mass
+        root = follow_centre_of_mass(scene, replace(plan, root_pos=root), wanted)
+        root[:, 2] = smooth_cap(root[:, 2], limit_of(root[:, :2]), scene.fps, CAP_HALF_WIDTH_S)
+    return follow_centre_of_mass(scene, replace(plan, root_pos=root), wanted)
 
 
 def _spring_mass_root(

@@ -1,0 +1,157 @@
+"""Sampling-based tracking: a beam search over small corrections to the tracker's targets.
+
+After SAMCON (Liu et al. 2010, "Sampling-based contact-rich motion control", SIGGRAPH): the
+whole-body controller of :mod:`sim.tracking` is good for a step or two, but a walk is
+chaotic, and a small error in one stance becomes a fall three steps later. So the reference is
+tracked window by window (:attr:`SearchSettings.window_s`); from each of the
+:attr:`SearchSettings.beam` best states so far, the window is simulated several times, once as
+the controller would and otherwise with a random constant offset added to every actuated
+hinge's target (Gaussian, :attr:`SearchSettings.sigma_leg_rad` on the legs and
+:attr:`SearchSettings.sigma_rad` elsewhere); the ``beam`` end states of lowest cost go on.
+
+Nothing changes about the physics: every sample is a full MuJoCo simulation of the same
+humanoid, the root unactuated and nothing pushing it, started from a state MuJoCo itself
+produced (``mj_getState`` / ``mj_setState``). The search only chooses the targets.
+
+The cost of a state (:func:`state_cost`) is what predicts a fall a step later, relative to the
+reference at its played clock: the horizontal capture-point error (m), the tilt of the root's
+up axis (degrees), the head's height error (m), and the mean body17 error in the root's frame
+(the pose, m), each divided by its scale in :class:`SearchSettings` and squared. A fallen
+state costs infinity.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+from tqdm import tqdm
+
+from avatar_models.body17 import BODY17
+from sim.tracking import Progress, Reference, Tracker, TrackingResult, TrackingSettings, _up
+
+HEAD = BODY17.index("head")
+STATE = mujoco.mjtState.mjSTATE_INTEGRATION
+
+
+@dataclass(frozen=True)
+class SearchSettings:
+    """Beam search parameters.
+
+    Attributes:
+        window_s: length of a window with one constant target offset (SAMCON uses 0.1 s).
+        samples: simulations of each window per kept state (the first without an offset).
+        beam: states kept after each window.
+        sigma_rad, sigma_leg_rad: standard deviation of the target offsets, upper body and
+            legs (hips, knees, ankles, toes).
+        capture_scale_m, tilt_scale_deg, head_scale_m, pose_scale_m: cost scales.
+        seed: random generator seed (the search is deterministic for a seed).
+    """
+
+    window_s: float = 0.2
+    samples: int = 4
+    beam: int = 4
+    sigma_rad: float = 0.03
+    sigma_leg_rad: float = 0.08
+    capture_scale_m: float = 0.05
+    tilt_scale_deg: float = 5.0
+    head_scale_m: float = 0.05
+    pose_scale_m: float = 0.05
+    seed: int = 0
+
+
+@dataclass(frozen=True)
+class _Node:
+    cost: float
+    state: np.ndarray
+    progress: Progress
+
+
+def state_cost(
+    tracker: Tracker, ref: Reference, progress: Progress, search: SearchSettings
+) -> float:
+    """Cost of the tracker's current state against the reference at ``progress.clock``
+    (module docstring); infinity once fallen."""
+    d = tracker.data
+    clock = min(progress.clock, ref.qpos.shape[0] - 1.0)
+    i = min(int(clock), ref.qpos.shape[0] - 2)
+    a = clock - i
+    com = (1 - a) * ref.com[i] + a * ref.com[i + 1]
+    sites = (1 - a) * ref.sites[i] + a * ref.sites[i + 1]
+    q_ref = ref.qpos[int(round(clock))]
+    tracker._com_jacobian()
+    capture = np.linalg.norm(tracker._capture_error(q_ref, com))
+    tilt = np.degrees(np.arccos(np.clip(_up(d.qpos[None])[0] @ _up(q_ref[None])[0], -1, 1)))
+    head = abs(d.site_xpos[tracker.sites[HEAD], 2] - sites[HEAD, 2])
+    if (
+        tilt > tracker.settings.fall_tilt_deg
+        or head > (1 - tracker.settings.fall_head_ratio) * (sites[HEAD, 2])
+    ):
+        return np.inf
+    root = tracker.sites[BODY17.index("pelvis")]
+    pose = np.linalg.norm(
+        (d.site_xpos[tracker.sites] - d.site_xpos[root]) - (sites - sites[BODY17.index("pelvis")]),
+        axis=1,
+    ).mean()
+    return float(
+        (capture / search.capture_scale_m) ** 2
+        + (tilt / search.tilt_scale_deg) ** 2
+        + (head / search.head_scale_m) ** 2
+        + (pose / search.pose_scale_m) ** 2
+    )
+
+
+def _leg_actuators(model: mujoco.MjModel) -> np.ndarray:
+    """``(nu,)`` bool: actuators of joints at or below a thigh."""
+    leg = np.zeros(model.nbody, bool)
+    for name in ("Bip01 L Thigh", "Bip01 R Thigh"):
+        leg[model.body(name).id] = True
+    for b in range(1, model.nbody):  # parents come before children in MuJoCo's order
+        leg[b] |= leg[model.body_parentid[b]]
+    return leg[model.jnt_bodyid[model.actuator_trnid[:, 0]]]
+
+
+def search_track(
+    model: mujoco.MjModel,
+    qpos_ref: np.ndarray,
+    fps: float,
+    settings: TrackingSettings | None = None,
+    search: SearchSettings | None = None,
+    progress_bar: bool = False,
+) -> TrackingResult:
+    """Track ``qpos_ref (T, nq)`` at ``fps`` by beam search (module docstring) with a
+    :class:`~sim.tracking.Tracker` on ``model`` (which it modifies). Costs about
+    ``samples x beam`` plain tracking runs."""
+    search = search or SearchSettings()
+    tracker = Tracker(model, settings)
+    m, d = tracker.model, tracker.data
+    ref = tracker.reference(qpos_ref, fps)
+    rng = np.random.default_rng(search.seed)
+    sigma = np.where(_leg_actuators(m), search.sigma_leg_rad, search.sigma_rad)
+    window = max(1, int(round(search.window_s / m.opt.timestep)))
+    size = mujoco.mj_stateSize(m, STATE)
+    start = tracker.start(ref)
+    state = np.empty(size)
+    mujoco.mj_getState(m, d, state, STATE)
+    beam = [_Node(0.0, state, start)]
+    total = tracker.steps_of(ref)
+    bar = tqdm(total=total, unit="step", desc="search", disable=not progress_bar, leave=False)
+    while not tracker.finished(ref, beam[0].progress):
+        children = []
+        for node in beam:
+            for sample in range(search.samples):
+                offset = None if sample == 0 else rng.normal(0.0, sigma)
+                mujoco.mj_setState(m, d, node.state, STATE)
+                mujoco.mj_step1(m, d)
+                progress = tracker.advance(ref, node.progress, window, offset)
+                cost = state_cost(tracker, ref, progress, search)
+                state = np.empty(size)
+                mujoco.mj_getState(m, d, state, STATE)
+                children.append(_Node(cost, state, progress))
+        children.sort(key=lambda c: c.cost)
+        alive = [c for c in children if np.isfinite(c.cost)]
+        beam = (alive or children)[: search.beam]
+        bar.update(beam[0].progress.step - bar.n)
+    bar.close()
+    return tracker.result(ref, beam[0].progress.frames)
