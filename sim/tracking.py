@@ -489,7 +489,8 @@ class Tracker:
 
     def result(self, ref: Reference, frames: list[tuple]) -> TrackingResult:
         """The :class:`TrackingResult` of the recorded ``frames`` (one per reference frame)."""
-        reference_frame, qpos, sites, torque, power = (np.array(c) for c in zip(*frames))
+        columns = zip(*frames, strict=True)
+        reference_frame, qpos, sites, torque, power = (np.array(c) for c in columns)
         ref_sites = _at_frames(ref.sites, reference_frame)
         qpos_ref = ref.qpos[np.round(reference_frame).astype(int)]
         return TrackingResult(

@@ -159,9 +159,10 @@ def centre_of_pressure(
     plant_at: Callable[[np.ndarray], np.ndarray],
 ) -> tuple[np.ndarray, np.ndarray]:
     """Where a foot of :func:`gait_track` (same arguments, at ``times (T,)`` s, which may
-    reach beyond the clip) presses on the floor while it stands: ``(T, 3)`` from the heel at heel strike to the ball at toe-off (smoothstep over
-    stance; the heel-to-toe rollover of the centre of pressure, Perry & Burnfield ch. 4), and
-    the stance progress ``(T,)`` 0..1 (NaN while the foot swings)."""
+    reach beyond the clip) presses on the floor while it stands: ``(T, 3)`` from the heel at
+    heel strike to the ball at toe-off (smoothstep over stance; the heel-to-toe rollover of
+    the centre of pressure, Perry & Burnfield ch. 4), and the stance progress ``(T,)`` 0..1
+    (NaN while the foot swings)."""
     geom = FootGeometry.of(scene)
     cycle, ph = phase(times, frequency, offset)
     u = ph / duty

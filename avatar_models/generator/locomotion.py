@@ -208,11 +208,11 @@ def _pendulum_root(
     limit_of: Callable[[np.ndarray], np.ndarray],
 ) -> np.ndarray:
     """``(T, 3)`` root positions whose centre of mass is the linear inverted pendulum over
-    ``zmp (pad + T + pad, 2)`` (:func:`~avatar_models.generator.com.lipm_centre_of_mass` at the plan's
-    mean centre-of-mass height): it slows over the stance foot and speeds up between steps,
-    and sways over each foot, so the floor can give every force it needs. Heights are the
-    plan's, lowered smoothly where the legs would not reach their feet (the root under
-    ``limit_of(root_xy (T, 2)) (T,)``)."""
+    ``zmp (pad + T + pad, 2)`` (:func:`~avatar_models.generator.com.lipm_centre_of_mass` at
+    the plan's mean centre-of-mass height): it slows over the stance foot and speeds up
+    between steps, and sways over each foot, so the floor can give every force it needs.
+    Heights are the plan's, lowered smoothly where the legs would not reach their feet (the
+    root under ``limit_of(root_xy (T, 2)) (T,)``)."""
     height = plan_centre_of_mass(scene, plan)[:, 2].mean()
     wanted = np.full((scene.n_frames, 3), np.nan)
     wanted[:, :2] = lipm_centre_of_mass(zmp, height, scene.fps)[pad : pad + scene.n_frames]
