@@ -134,6 +134,10 @@ class TrackingSettings:
     control_period: int = 5
     fall_head_ratio: float = 0.6
     fall_tilt_deg: float = 60.0
+    ankle_height_weight: float = 0.0
+    upper_body_weight: float = 1.0
+    kp_ankle: float = 100.0
+    kd_ankle: float = 20.0
 
 
 @dataclass(frozen=True)
@@ -272,6 +276,8 @@ class Reference:
         swing: ``(T, 2)`` foot-placement weights (:meth:`Tracker.swing_weights`).
         sites: ``(T, 17, 3)`` body17 site positions.
         com: ``(T, 3, 3)`` whole-body centre of mass position, velocity, acceleration.
+        ankle_height: ``(T, 3, 2)`` height of the ankle sites (left, right), its velocity
+            and acceleration.
     """
 
     qpos: np.ndarray
@@ -281,6 +287,7 @@ class Reference:
     swing: np.ndarray
     sites: np.ndarray
     com: np.ndarray
+    ankle_height: np.ndarray
     fps: float
 
 
@@ -317,6 +324,13 @@ class Tracker:
         model.actuator_gainprm[:, 0] = 1.0
         model.actuator_biasprm[:] = 0.0
         model.actuator_ctrllimited[:] = 0
+        # Only the floor collides with the body: the retargeted limbs of real clips overlap
+        # (upper arms 4 cm into the chest, calves crossing), and contacts between them would
+        # push with forces the controller does not know of. Self-collision is a check on the
+        # reference (sim.checks.self_collision), not something to simulate while tracking.
+        world = model.geom_bodyid == 0
+        model.geom_contype[:] = np.where(world, 0, 1)
+        model.geom_conaffinity[:] = np.where(world, 1, 0)
         self.data = mujoco.MjData(model)
         self.dof = model.jnt_dofadr[model.actuator_trnid[:, 0]]
         self.hinge_qadr = model.jnt_qposadr[model.actuator_trnid[:, 0]]
@@ -349,6 +363,13 @@ class Tracker:
         self.kp[:2] = s.kp_root_xy
         self.weight = np.ones(nv)
         self.weight[:ROOT_DOF] = s.root_weight
+        leg = np.zeros(model.nbody, bool)
+        for name in THIGHS:
+            leg[model.body(name).id] = True
+        for b in range(1, model.nbody):
+            leg[b] |= leg[model.body_parentid[b]]
+        upper = np.flatnonzero(~leg[model.dof_bodyid])
+        self.weight[upper[upper >= ROOT_DOF]] = s.upper_body_weight
         rest = mujoco.MjData(model)
         mujoco.mj_kinematics(model, rest)  # qpos0 stands flat-footed on the floor
         self.sole_normal = [rest.xmat[b].reshape(3, 3)[2] for b in self.feet]  # R^T z
@@ -407,9 +428,6 @@ class Tracker:
         qacc = np.gradient(qvel, 1.0 / fps, axis=0)
         if sigma > 0:
             qacc = gaussian_filter1d(qacc, sigma, axis=0, mode="nearest")
-        com = self.reference_com(qpos_ref)
-        com_vel = gaussian_filter1d(np.gradient(com, 1.0 / fps, axis=0), 1.0, axis=0)
-        com_acc = gaussian_filter1d(np.gradient(com_vel, 1.0 / fps, axis=0), 1.0, axis=0)
         return Reference(
             qpos=qpos_ref,
             forward=forward_differences(m, qpos_ref, fps),
@@ -417,7 +435,10 @@ class Tracker:
             qacc=qacc,
             swing=self.swing_weights(qpos_ref, fps),
             sites=self.reference_sites(qpos_ref),
-            com=np.stack([com, com_vel, com_acc], axis=1),
+            com=_with_derivatives(self.reference_com(qpos_ref), fps),
+            ankle_height=_with_derivatives(
+                self._site_positions(qpos_ref, self.ankles)[..., 2], fps
+            ),
             fps=fps,
         )
 
@@ -474,6 +495,7 @@ class Tracker:
                 if target_offset is not None:
                     q_target[self.hinge_qadr] += target_offset
                 standing = (swinging == 0) & s.level_stance_feet
+                self._ankle_target = (1 - a) * ref.ankle_height[i] + a * ref.ankle_height[i + 1]
                 tau = self._torques(q_target, v_target, a_target, com, standing)
             d.ctrl[:] = tau
             mujoco.mj_step2(m, d)
@@ -576,6 +598,18 @@ class Tracker:
         for jr, acc in self._foot_tasks(q_target, v_target, standing):
             hess[:nv, :nv] += s.foot_weight * jr.T @ jr
             grad[:nv] -= s.foot_weight * jr.T @ acc
+        if s.ankle_height_weight > 0:
+            jz = np.zeros((3, nv))
+            for side, site in enumerate(self.ankles):
+                mujoco.mj_jacSite(m, d, jz, None, site)
+                z, vz, az = self._ankle_target[:, side]
+                acc = (
+                    az
+                    + s.kp_ankle * (z - d.site_xpos[site, 2])
+                    + s.kd_ankle * (vz - jz[2] @ d.qvel)
+                )
+                hess[:nv, :nv] += s.ankle_height_weight * np.outer(jz[2], jz[2])
+                grad[:nv] -= s.ankle_height_weight * jz[2] * acc
         jcom, wcom = self._jac_com, np.asarray(s.com_weight)[:, None]
         com_acc = (
             com[2] + s.kp_com * (com[0] - d.subtree_com[0]) + s.kd_com * (com[1] - jcom @ d.qvel)
@@ -648,6 +682,14 @@ class Tracker:
         tilt = np.degrees(np.arccos(np.clip(np.sum(_up(qpos) * _up(qpos_ref), -1), -1, 1)))
         fallen = np.flatnonzero(low | (tilt > self.settings.fall_tilt_deg))
         return int(fallen[0]) if fallen.size else None
+
+
+def _with_derivatives(x: np.ndarray, fps: float) -> np.ndarray:
+    """``(T, 3, ...)`` ``x (T, ...)``, its velocity and acceleration (central differences,
+    each smoothed by a 1-frame Gaussian: finite differences of mocap are noisy)."""
+    vel = gaussian_filter1d(np.gradient(x, 1.0 / fps, axis=0), 1.0, axis=0)
+    acc = gaussian_filter1d(np.gradient(vel, 1.0 / fps, axis=0), 1.0, axis=0)
+    return np.stack([x, vel, acc], axis=1)
 
 
 def _at_frames(values: np.ndarray, frames: np.ndarray) -> np.ndarray:
