@@ -46,6 +46,8 @@ class SearchSettings:
         sigma_rad, sigma_leg_rad: standard deviation of the target offsets, upper body and
             legs (hips, knees, ankles, toes).
         capture_scale_m, tilt_scale_deg, head_scale_m, pose_scale_m: cost scales.
+        retry_factor, max_backtracks: what is done when every sample falls
+            (:func:`search_track`).
         seed: random generator seed (the search is deterministic for a seed).
     """
 
@@ -58,14 +60,38 @@ class SearchSettings:
     tilt_scale_deg: float = 5.0
     head_scale_m: float = 0.05
     pose_scale_m: float = 0.05
+    retry_factor: int = 4
+    max_backtracks: int = 20
     seed: int = 0
 
 
 @dataclass(frozen=True)
 class _Node:
+    """A simulated state on a search path: its cost, MuJoCo's state, the controller's
+    state, and the target offsets ``(W, nu)`` of the windows that led to it."""
+
     cost: float
     state: np.ndarray
     progress: Progress
+    offsets: tuple
+
+
+@dataclass(frozen=True)
+class SearchedTracking:
+    """The result of :func:`search_track`.
+
+    Attributes:
+        result: the tracking of the best path.
+        offsets: ``(W, nu)`` its target offset in each window (radians; zeros where the
+            plain controller's targets won), for :func:`replay`.
+        window_steps: simulation steps per window.
+        simulated_s: seconds simulated in all, samples included (the search's cost).
+    """
+
+    result: TrackingResult
+    offsets: np.ndarray
+    window_steps: int
+    simulated_s: float
 
 
 def state_cost(
@@ -119,10 +145,16 @@ def search_track(
     settings: TrackingSettings | None = None,
     search: SearchSettings | None = None,
     progress_bar: bool = False,
-) -> TrackingResult:
+) -> SearchedTracking:
     """Track ``qpos_ref (T, nq)`` at ``fps`` by beam search (module docstring) with a
     :class:`~sim.tracking.Tracker` on ``model`` (which it modifies). Costs about
-    ``samples x beam`` plain tracking runs."""
+    ``samples x beam`` plain tracking runs.
+
+    When every sample of a window falls, the window is sampled again with
+    :attr:`SearchSettings.retry_factor` times as many samples; when those fall too, the search
+    steps back one window and samples that one more widely (at most
+    :attr:`SearchSettings.max_backtracks` times in all). If nothing survives even then, the
+    path that fell last is returned (its result says when it fell)."""
     search = search or SearchSettings()
     tracker = Tracker(model, settings)
     m, d = tracker.model, tracker.data
@@ -131,27 +163,64 @@ def search_track(
     sigma = np.where(_leg_actuators(m), search.sigma_leg_rad, search.sigma_rad)
     window = max(1, int(round(search.window_s / m.opt.timestep)))
     size = mujoco.mj_stateSize(m, STATE)
-    start = tracker.start(ref)
-    state = np.empty(size)
-    mujoco.mj_getState(m, d, state, STATE)
-    beam = [_Node(0.0, state, start)]
-    total = tracker.steps_of(ref)
-    bar = tqdm(total=total, unit="step", desc="search", disable=not progress_bar, leave=False)
-    while not tracker.finished(ref, beam[0].progress):
+
+    def expand(beam: list[_Node], samples: int) -> list[_Node]:
         children = []
         for node in beam:
-            for sample in range(search.samples):
-                offset = None if sample == 0 else rng.normal(0.0, sigma)
+            for sample in range(samples):
+                offset = np.zeros(m.nu) if sample == 0 else rng.normal(0.0, sigma)
                 mujoco.mj_setState(m, d, node.state, STATE)
                 mujoco.mj_step1(m, d)
                 progress = tracker.advance(ref, node.progress, window, offset)
-                cost = state_cost(tracker, ref, progress, search)
                 state = np.empty(size)
                 mujoco.mj_getState(m, d, state, STATE)
-                children.append(_Node(cost, state, progress))
+                cost = state_cost(tracker, ref, progress, search)
+                children.append(_Node(cost, state, progress, node.offsets + (offset,)))
         children.sort(key=lambda c: c.cost)
-        alive = [c for c in children if np.isfinite(c.cost)]
-        beam = (alive or children)[: search.beam]
-        bar.update(beam[0].progress.step - bar.n)
+        return children
+
+    start = tracker.start(ref)
+    state = np.empty(size)
+    mujoco.mj_getState(m, d, state, STATE)
+    history = [[_Node(0.0, state, start, ())]]  # the beam after each window
+    simulated, backtracks, last_fallen = 0, 0, history[0][0]
+    bar = tqdm(total=tracker.steps_of(ref), unit="step", disable=not progress_bar, leave=False)
+    while not tracker.finished(ref, history[-1][0].progress):
+        samples, children = search.samples, []
+        for _ in range(2):
+            children = expand(history[-1], samples)
+            simulated += len(children) * window
+            if np.isfinite(children[0].cost):
+                break
+            samples *= search.retry_factor
+        if not np.isfinite(children[0].cost):
+            last_fallen = children[0]
+            if backtracks >= search.max_backtracks or len(history) == 1:
+                break
+            backtracks += 1
+            history.pop()
+            continue
+        history.append([c for c in children if np.isfinite(c.cost)][: search.beam])
+        bar.update(history[-1][0].progress.step - bar.n)
     bar.close()
-    return tracker.result(ref, beam[0].progress.frames)
+    best = history[-1][0] if tracker.finished(ref, history[-1][0].progress) else last_fallen
+    return SearchedTracking(
+        result=tracker.result(ref, best.progress.frames),
+        offsets=np.array(best.offsets).reshape(-1, m.nu),
+        window_steps=window,
+        simulated_s=simulated * m.opt.timestep,
+    )
+
+
+def replay(
+    tracker: Tracker, qpos_ref: np.ndarray, fps: float, offsets: np.ndarray, window_steps: int
+) -> TrackingResult:
+    """Track ``qpos_ref`` again with ``tracker`` (a fresh one, same model and settings as the
+    search's) plus the target ``offsets (W, nu)`` the search found, one per window of
+    ``window_steps``: one uninterrupted simulation, which reproduces the search's result
+    (MuJoCo is deterministic)."""
+    ref = tracker.reference(qpos_ref, fps)
+    progress = tracker.start(ref)
+    for offset in offsets:
+        progress = tracker.advance(ref, progress, window_steps, offset)
+    return tracker.result(ref, progress.frames)
