@@ -7,9 +7,6 @@ runs, and nothing is written for a scenario that does not validate.
 
 from __future__ import annotations
 
-import os
-import shutil
-import tempfile
 import time
 from pathlib import Path
 from typing import Any
@@ -17,7 +14,14 @@ from typing import Any
 from rich.console import Console
 
 from scripts.report_html import render_report
-from scripts.results import CheckResult, junit_xml, versions, write_atomic, write_json
+from scripts.results import (
+    CheckResult,
+    atomic_dir,
+    junit_xml,
+    versions,
+    write_atomic,
+    write_json,
+)
 from scripts.run_context import RunContext
 from scripts.scenario import Scenario, ScenarioError
 from scripts.stages import STAGES, physics
@@ -60,21 +64,8 @@ def run_scenario(
     """Run every stage, evaluate thresholds, write results.json and junit.xml into ``out_dir``."""
     validate(scenario)
     console = console or Console(stderr=True)
-    final_dir = Path(out_dir)
-    final_dir.parent.mkdir(parents=True, exist_ok=True)
-    # Stages write into a hidden sibling folder that replaces ``out_dir`` only when the run
-    # completes, so a failed run never leaves half its outputs behind.
-    out_dir = Path(tempfile.mkdtemp(dir=final_dir.parent, prefix=f".{final_dir.name}.partial-"))
-    try:
-        results = _run_stages(scenario, out_dir, console)
-    except BaseException:
-        shutil.rmtree(out_dir, ignore_errors=True)
-        raise
-    if final_dir.exists():
-        shutil.rmtree(final_dir)
-    os.replace(out_dir, final_dir)
-    final_dir.chmod(0o755)
-    return results
+    with atomic_dir(out_dir) as partial:
+        return _run_stages(scenario, partial, console)
 
 
 def _run_stages(scenario: Scenario, out_dir: Path, console: Console) -> dict[str, Any]:

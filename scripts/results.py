@@ -6,8 +6,11 @@ import json
 import math
 import os
 import platform
+import shutil
 import tempfile
 import xml.etree.ElementTree as ET
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from importlib import metadata
 from pathlib import Path
@@ -48,6 +51,24 @@ def versions() -> dict[str, str]:
         except metadata.PackageNotFoundError:
             out[dist] = "absent"
     return out
+
+
+@contextmanager
+def atomic_dir(final_dir: Path) -> Iterator[Path]:
+    """A hidden sibling folder to write into; it replaces ``final_dir`` only when the block
+    completes, so a failed run never leaves half its outputs behind."""
+    final_dir = Path(final_dir)
+    final_dir.parent.mkdir(parents=True, exist_ok=True)
+    out_dir = Path(tempfile.mkdtemp(dir=final_dir.parent, prefix=f".{final_dir.name}.partial-"))
+    try:
+        yield out_dir
+    except BaseException:
+        shutil.rmtree(out_dir, ignore_errors=True)
+        raise
+    if final_dir.exists():
+        shutil.rmtree(final_dir)
+    os.replace(out_dir, final_dir)
+    final_dir.chmod(0o755)
 
 
 def write_atomic(path: Path, data: bytes | str) -> Path:

@@ -37,13 +37,17 @@ CONTRACT_KEYS = (
 
 
 def body_and_motion(
-    motion: Motion, body: BodyDescription | None, retarget_foreign: bool = True
+    motion: Motion,
+    body: BodyDescription | None,
+    retarget_foreign: bool = True,
+    level_feet: bool = False,
 ) -> tuple[BodyDescription, Motion]:
     """The body to replay ``motion`` on and the motion on that body's skeleton.
 
     A motion on a rig whose rest pose does not stand (e.g. Bandai), or on another rig than
     ``body``'s, is retargeted onto the humanoid by body17 IK (:func:`sim.retarget.retarget`);
     its mean residual is recorded in the returned motion's ``meta["retarget_residual_cm"]``.
+    ``level_feet`` is passed on to the retargeting (stance feet flat, for physics tracking).
 
     Raises:
         RetargetingNeeded: such a motion with ``retarget_foreign=False``.
@@ -65,7 +69,7 @@ def body_and_motion(
         raise RetargetingNeeded(f"{reason}; retarget the motion onto a humanoid rig first")
     from sim.retarget import retarget  # IK (mink) is only loaded when needed
 
-    result = retarget(motion, body)
+    result = retarget(motion, body, level_feet=level_feet)
     meta = {**result.motion.meta, "retarget_residual_cm": float(np.mean(result.residual_cm))}
     out = result.motion.replace(meta=meta)
     return (body if body is not None else build_body(out.skeleton)), out

@@ -1,0 +1,123 @@
+"""``avatarsim track MOTION``: the MuJoCo humanoid tracks a motion under physics, root unactuated.
+
+By default the sampling search of ``sim.sampling`` (SAMCON-style beam search over the
+whole-body controller's targets); ``--plain`` runs the controller alone (``sim.tracking``,
+about 10x real time, lasts a few steps on a walk). A clip shorter than ``--seconds`` is
+looped on its best gait cycle (``sim.tracking.looped``); a foreign rig is retargeted with its
+stance feet levelled. Writes ``tracking.csv``, ``tracking.json``, ``tracking.png`` into
+``--out`` (replaced only when the run completes), optionally the simulated motion for MuJoCo's
+viewer into ``--export``. Exit 1 when the humanoid falls, 2 for bad input.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from scripts.cli_common import JsonOpt, SeedOpt, console, emit_json, load_motion_arg, user_errors
+
+
+def register(app: typer.Typer) -> None:
+    @app.command()
+    @user_errors
+    def track(
+        motion: Annotated[
+            str,
+            typer.Argument(help="A .bvh, .amc (ASF beside it) or .npz file, or builtin:ACTIVITY."),
+        ],
+        seconds: Annotated[
+            float | None,
+            typer.Option(help="Length to track (s); loops a shorter clip. Default: the clip."),
+        ] = None,
+        plain: Annotated[
+            bool, typer.Option("--plain", help="The controller alone, no sampling search.")
+        ] = False,
+        samples: Annotated[int, typer.Option(help="Search: samples per kept state.")] = 4,
+        beam: Annotated[int, typer.Option(help="Search: states kept per window.")] = 4,
+        out: Annotated[Path, typer.Option(help="Folder for CSV, JSON and plot.")] = Path(
+            "out/track"
+        ),
+        export: Annotated[
+            Path | None, typer.Option(help="Also write the simulated motion for MuJoCo's viewer.")
+        ] = None,
+        unit: Annotated[str | None, typer.Option(help="File unit (see `info`).")] = None,
+        seed: SeedOpt = 0,
+        json_out: JsonOpt = None,
+    ) -> None:
+        """Physics tracking of a motion by the MuJoCo humanoid. Exit 1 if it falls."""
+        from avatar_models.body.ik import humanoid_model
+        from avatar_models.errors import MotionValueError
+        from scripts.results import atomic_dir
+        from sim.plausibility import body_and_motion
+        from sim.sampling import SearchSettings, search_track
+        from sim.tracking import looped
+        from sim.tracking import track as plain_track
+        from sim.tracking_report import write_outputs
+
+        if seconds is not None and not seconds > 0:
+            raise MotionValueError(f"--seconds must be positive, got {seconds}")
+        if samples < 1 or beam < 1:
+            raise MotionValueError("--samples and --beam must be at least 1")
+        m = load_motion_arg(motion, unit, seed, duration_s=seconds or 10.0)
+        body, m = body_and_motion(m, None, level_feet=True)
+        qpos = body.qpos_from_motion(m)
+        if seconds is not None:
+            qpos = looped(qpos, m.fps, seconds)
+        summary_extra = {"motion": motion, "seed": seed, "fps": m.fps}
+        if "retarget_residual_cm" in m.meta:
+            summary_extra["retarget_residual_cm"] = m.meta["retarget_residual_cm"]
+        start = time.perf_counter()
+        if plain:
+            result = plain_track(humanoid_model(body), qpos, m.fps)
+            summary_extra |= {"mode": "plain"}
+        else:
+            search = SearchSettings(samples=samples, beam=beam, seed=seed)
+            searched = search_track(
+                humanoid_model(body), qpos, m.fps, search=search, progress_bar=True
+            )
+            result = searched.result
+            summary_extra |= {
+                "mode": "search",
+                "samples": samples,
+                "beam": beam,
+                "simulated_s": searched.simulated_s,
+            }
+        wall = time.perf_counter() - start
+        summary = result.summary() | summary_extra
+        summary |= {"wall_s": wall, "x_real_time": summary["duration_s"] / wall}
+        table = Table(title=f"physics tracking ({summary['mode']}): {motion}")
+        for col in ("quantity", "value"):
+            table.add_column(col)
+        fell = "never" if not result.fell else f"[red]at {result.fall_time_s:.2f} s[/]"
+        rows = [
+            ("tracked", f"{summary['duration_s']:.2f} s"),
+            ("fell", fell),
+            (
+                "body17 error mean / p95",
+                f"{summary['body17_err_cm_mean']:.1f} / {summary['body17_err_cm_p95']:.1f} cm",
+            ),
+            ("energy", f"{summary['energy_j']:.0f} J"),
+            ("mean |torque|", f"{summary['mean_abs_torque_nm']:.1f} N m"),
+            ("speed", f"{summary['x_real_time']:.2f}x real time ({wall:.1f} s wall)"),
+        ]
+        for row in rows:
+            table.add_row(*row)
+        console.print(table)
+        with atomic_dir(out) as partial:
+            written = write_outputs(result, summary, partial, f"physics tracking: {motion}")
+        console.print(f"wrote {', '.join(str(out / p.name) for p in written.values())}")
+        if export is not None:
+            from sim.export import export_replay
+
+            export_replay(body, result.qpos, m.fps, export)
+            console.print(
+                f"MuJoCo viewer files in {export}/ (python -m mujoco.viewer --mjcf "
+                f"{export}/replay.xml)"
+            )
+        emit_json(json_out, summary)
+        if result.fell:
+            raise typer.Exit(1)

@@ -1,0 +1,55 @@
+"""``avatarsim track``: outputs and summary, exit 1 when the humanoid falls, exit 2 for bad
+input, and nothing written on failure."""
+
+from __future__ import annotations
+
+import json
+
+import mujoco
+import numpy as np
+from typer.testing import CliRunner
+
+from avatar_models.formats import save_motion
+from avatar_models.generator import generate
+from scripts.cli import app
+
+runner = CliRunner()
+
+
+def test_track_searches_writes_outputs_and_exports(tmp_path):
+    out, export, js = tmp_path / "out", tmp_path / "viewer", tmp_path / "r.json"
+    args = ["track", "builtin:walk", "--seconds", "1", "--out", str(out), "--json", str(js)]
+    result = runner.invoke(app, [*args, "--export", str(export)])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(js.read_text())
+    assert summary["mode"] == "search" and summary["fell"] is False
+    assert summary["simulated_s"] >= 4 * 1.0  # every kept state is sampled 4 times
+    assert json.loads((out / "tracking.json").read_text()) == summary
+    assert {p.name for p in out.iterdir()} == {"tracking.csv", "tracking.json", "tracking.png"}
+    rows = np.genfromtxt(out / "tracking.csv", delimiter=",", names=True)
+    assert len(rows) == 91 and rows["fallen"].max() == 0  # 1 s at the generator's 90 fps
+    assert abs(rows["body17_err_cm"].mean() - summary["body17_err_cm_mean"]) < 1e-6
+    model = mujoco.MjModel.from_xml_path(str(export / "replay.xml"))
+    assert model.nkey == 91
+
+
+def test_a_fall_exits_1(tmp_path):
+    """A reference walking 3 m above the floor: the humanoid starts there and drops to the
+    floor, its head far below the reference's: a fall."""
+    motion = generate("walk", duration_s=1.5, fps=30.0)
+    airborne = motion.replace(root_pos=motion.root_pos * [1.0, 1.0, 0.0] + [0.0, 0.0, 3.0])
+    path = save_motion(airborne, tmp_path / "air.npz")
+    result = runner.invoke(app, ["track", str(path), "--plain", "--out", str(tmp_path / "o")])
+    assert result.exit_code == 1, result.output
+    assert "fell" in result.output
+
+
+def test_bad_input_exits_2_and_writes_nothing(tmp_path):
+    path = save_motion(generate("walk", duration_s=1.0, fps=30.0), tmp_path / "w.npz")
+    out = tmp_path / "o"
+    for args in (["--seconds", "-1"], ["--samples", "0"]):
+        result = runner.invoke(app, ["track", str(path), "--out", str(out), *args])
+        assert result.exit_code == 2, result.output
+    result = runner.invoke(app, ["track", str(tmp_path / "missing.bvh"), "--out", str(out)])
+    assert result.exit_code == 2
+    assert not out.exists()
