@@ -1,10 +1,13 @@
-"""Physics tracking speed next to real time, and IK retargeting frames/s.
+"""Physics tracking speed next to real time, how long walks stay upright, and IK
+retargeting frames/s.
 
-Rows: simulated seconds per wall second tracking the built-in walk (``sim.tracking``: a
-whole-body QP every 5 simulation steps, 100 Hz; aim at least 10x real time), next to real time (1x);
-retargeting frames/s (``sim.retarget``: body17 IK with mink) on a CMU clip from
-``../shared/mocap`` (the built-in walk when that folder is absent), next to the clip's
-own frame rate.
+Rows: simulated seconds per wall second tracking the built-in walk with the plain controller
+(``sim.tracking``: a whole-body QP every 5 simulation steps, 100 Hz; aim at least 10x real
+time) and with the sampling search (``sim.sampling``, 16 simulations of every window), next to
+real time (1x); the share of 10 s built-in walks (seeds 0-3) tracked without a fall by the
+search, next to the plain controller's share (not in ``--quick``); retargeting frames/s
+(``sim.retarget``: body17 IK with mink) on a CMU clip from ``../shared/mocap`` (the built-in
+walk when that folder is absent), next to the clip's own frame rate.
 """
 
 from __future__ import annotations
@@ -18,20 +21,45 @@ from avatar_models.formats import load_motion
 from avatar_models.generator import generate
 from scripts.benchmarks import BenchRow, best_of
 from sim.retarget import retarget
+from sim.sampling import search_track
 from sim.tracking import track
 
 MOCAP_DIR = Path(__file__).resolve().parents[2].parent / "shared" / "mocap"
 CMU_CLIP = "cmu/16_35.bvh"
 
 
-def _tracking_row(quick: bool) -> BenchRow:
-    seconds = 1.0 if quick else 3.0  # the walk stays upright for 3 s on every seed (tests)
+def _speed_rows(quick: bool) -> list[BenchRow]:
+    seconds = 1.0 if quick else 2.0  # the plain controller stays upright 2 s (tests)
     walk = generate("walk", duration_s=seconds, fps=30.0)
     body = build_body(walk.skeleton)
     qpos = body.qpos_from_motion(walk)
-    wall = best_of(lambda: track(humanoid_model(body), qpos, walk.fps), 1 if quick else 3)
+    repeats = 1 if quick else 3
+    plain = best_of(lambda: track(humanoid_model(body), qpos, walk.fps), repeats)
+    search = best_of(lambda: search_track(humanoid_model(body), qpos, walk.fps), 1)
+    note = f"{seconds:.0f} s walk"
+    return [
+        BenchRow("tracking[walk, plain]", "x real time", seconds / plain, 1.0, "real time", note),
+        BenchRow("tracking[walk, search]", "x real time", seconds / search, 1.0, "real time", note),
+    ]
+
+
+def _upright_row() -> BenchRow:
+    seeds, seconds = range(4), 10.0
+    upright = {"plain": 0, "search": 0}
+    for seed in seeds:
+        walk = generate("walk", duration_s=seconds, fps=30.0, seed=seed)
+        body = build_body(walk.skeleton)
+        qpos = body.qpos_from_motion(walk)
+        upright["plain"] += not track(humanoid_model(body), qpos, walk.fps).fell
+        upright["search"] += not search_track(humanoid_model(body), qpos, walk.fps).result.fell
+    n = len(seeds)
     return BenchRow(
-        "tracking[walk]", "x real time", seconds / wall, 1.0, "real time", f"{seconds:.0f} s"
+        "upright[walk 10 s, search]",
+        "share of seeds",
+        upright["search"] / n,
+        upright["plain"] / n,
+        "plain controller",
+        f"seeds 0-{n - 1}",
     )
 
 
@@ -55,4 +83,4 @@ def _retarget_row(quick: bool) -> BenchRow:
 
 def run(quick: bool = False) -> list[BenchRow]:
     """Tracking and retargeting rows; see the module docstring."""
-    return [_tracking_row(quick), _retarget_row(quick)]
+    return [*_speed_rows(quick), *([] if quick else [_upright_row()]), _retarget_row(quick)]
