@@ -17,6 +17,9 @@ A scenario names a motion source, the body, the stages to run and pass/fail thre
     replay_error_mm_max = 1.0
     [physics]                 # sim.thresholds.CheckConfig overrides (definitions, thresholds)
     skate_cm_s_median = 40.0
+    [tracking]                # physics tracking of the ground truth (optional)
+    seconds = 3.0
+    search = true             # false: the plain controller (fast, lasts a few steps)
 
 Unknown keys, wrong types and impossible values raise :class:`ScenarioError` naming the key.
 """
@@ -96,6 +99,15 @@ class CamerasSpec:
 
 
 @dataclass(frozen=True)
+class TrackingSpec:
+    """Physics tracking of the ground truth (``sim.sampling`` search, or the plain
+    controller): ``seconds`` tracked from the start, the clip looped when shorter."""
+
+    seconds: float = 3.0
+    search: bool = True
+
+
+@dataclass(frozen=True)
 class Threshold:
     """Pass when ``value <= max`` (and/or ``value >= min``)."""
 
@@ -124,6 +136,7 @@ class Scenario:
     devices: DevicesSpec | None = None
     synthesis: SynthesisSpec | None = None
     cameras: CamerasSpec | None = None
+    tracking: TrackingSpec | None = None
     thresholds: dict[str, Threshold] = field(default_factory=dict)
     physics: dict[str, float] = field(default_factory=dict)
     path: str | None = None
@@ -178,7 +191,7 @@ def _threshold(name: str, raw: Any) -> Threshold:
 def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
     """Validate a parsed TOML table into a :class:`Scenario`."""
     top = {"name", "seed", "motion", "body", "report", "devices", "synthesis", "cameras"}
-    top |= {"thresholds", "physics"}
+    top |= {"tracking", "thresholds", "physics"}
     unknown = sorted(set(data) - top)
     if unknown:
         raise ScenarioError(f"unknown top-level key(s) {unknown}; allowed: {sorted(top)}")
@@ -191,8 +204,11 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
             ("devices", DevicesSpec),
             ("synthesis", SynthesisSpec),
             ("cameras", CamerasSpec),
+            ("tracking", TrackingSpec),
         )
     }
+    if optional["tracking"] and not optional["tracking"].seconds > 0:
+        raise ScenarioError("tracking.seconds must be positive")
     if optional["devices"] and optional["devices"].noise not in VR_NOISE:
         raise ScenarioError(f"devices.noise must be one of {VR_NOISE}")
     if optional["synthesis"] and not optional["devices"]:

@@ -1,6 +1,15 @@
 """Scenario stages. Each module has ``METRICS`` (name -> meaning) and ``run(ctx)``; the order
 of :data:`STAGES` is the data flow of ARCHITECTURE.md."""
 
-from scripts.stages import body, cameras, devices, motion, physics, pictures, synthesis
+from scripts.stages import (
+    body,
+    cameras,
+    devices,
+    motion,
+    physics,
+    pictures,
+    synthesis,
+    tracking,
+)
 
-STAGES = (motion, body, physics, devices, synthesis, cameras, pictures)
+STAGES = (motion, body, physics, tracking, devices, synthesis, cameras, pictures)

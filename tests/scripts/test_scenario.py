@@ -33,6 +33,8 @@ def test_default_scenario_is_valid():
         ({"seed": 1.5}, "seed must be int"),
         ({"thresholds": {"x": "big"}}, "must be a number"),
         ({"thresholds": {"x": {"maximum": 1}}}, "must be a number"),
+        ({"tracking": {"seconds": 0}}, "tracking.seconds must be positive"),
+        ({"tracking": {"search": "yes"}}, "tracking.search must be bool"),
     ],
 )
 def test_invalid_scenarios_name_the_problem(data, message):
@@ -88,3 +90,11 @@ def test_results_json_is_strict_json(tmp_path):
 def test_non_finite_thresholds_are_rejected():
     with pytest.raises(ScenarioError, match="finite"):
         parse_scenario({"thresholds": {"frames": float("nan")}})
+
+
+def test_tracking_thresholds_need_the_tracking_stage():
+    from scripts.pipeline import validate
+
+    with pytest.raises(ScenarioError, match="does not produce"):
+        validate(parse_scenario({"thresholds": {"tracking_fell": 0.0}}))
+    validate(parse_scenario({"tracking": {}, "thresholds": {"tracking_fell": 0.0}}))
