@@ -223,6 +223,8 @@ def looped(qpos: np.ndarray, fps: float, duration_s: float, min_cycle_s: float =
     n, need = qpos.shape[0], int(np.ceil(duration_s * fps)) + 1
     if n >= need:
         return qpos[:need]
+    if n < 3:
+        raise MotionValueError(f"clip too short to loop: {n} frames at {fps} fps")
     hinge = qpos[:, 7:]
     feature = np.hstack([hinge, np.gradient(hinge, axis=0) * 3.0, qpos[:, 2:3] * 10.0])
     dist = np.linalg.norm(feature[:, None] - feature[None], axis=-1)

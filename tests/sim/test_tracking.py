@@ -91,6 +91,8 @@ def test_bad_reference_is_refused(body):
         track(model, np.full((3, model.nq), np.nan), 30.0)
     with pytest.raises(MotionValueError, match="at least 2 frames"):
         track(model, model.qpos0[None], 30.0)
+    with pytest.raises(MotionValueError, match="too short to loop"):
+        looped(np.tile(model.qpos0, (2, 1)), 30.0, 5.0)
 
 
 def test_looped_clip_continues_the_walk(body):
