@@ -29,7 +29,16 @@ import numpy as np
 from tqdm import tqdm
 
 from avatar_models.body17 import BODY17
-from sim.tracking import Progress, Reference, Tracker, TrackingResult, TrackingSettings, _up
+from sim.tracking import (
+    THIGHS,
+    Progress,
+    Reference,
+    Tracker,
+    TrackingResult,
+    TrackingSettings,
+    _up,
+    subtree_mask,
+)
 
 HEAD = BODY17.index("head")
 STATE = mujoco.mjtState.mjSTATE_INTEGRATION
@@ -128,16 +137,6 @@ def state_cost(
     )
 
 
-def _leg_actuators(model: mujoco.MjModel) -> np.ndarray:
-    """``(nu,)`` bool: actuators of joints at or below a thigh."""
-    leg = np.zeros(model.nbody, bool)
-    for name in ("Bip01 L Thigh", "Bip01 R Thigh"):
-        leg[model.body(name).id] = True
-    for b in range(1, model.nbody):  # parents come before children in MuJoCo's order
-        leg[b] |= leg[model.body_parentid[b]]
-    return leg[model.jnt_bodyid[model.actuator_trnid[:, 0]]]
-
-
 def search_track(
     model: mujoco.MjModel,
     qpos_ref: np.ndarray,
@@ -160,7 +159,8 @@ def search_track(
     m, d = tracker.model, tracker.data
     ref = tracker.reference(qpos_ref, fps)
     rng = np.random.default_rng(search.seed)
-    sigma = np.where(_leg_actuators(m), search.sigma_leg_rad, search.sigma_rad)
+    leg = subtree_mask(m, THIGHS)[m.jnt_bodyid[m.actuator_trnid[:, 0]]]
+    sigma = np.where(leg, search.sigma_leg_rad, search.sigma_rad)
     window = max(1, int(round(search.window_s / m.opt.timestep)))
     size = mujoco.mj_stateSize(m, STATE)
 

@@ -245,6 +245,14 @@ def looped(qpos: np.ndarray, fps: float, duration_s: float, min_cycle_s: float =
     return np.vstack(pieces)[:need]
 
 
+def subtree_mask(model: mujoco.MjModel, names: tuple[str, ...]) -> np.ndarray:
+    """``(nbody,)`` bool: the bodies ``names`` and every body below them."""
+    mask = np.isin(np.arange(model.nbody), [model.body(name).id for name in names])
+    for b in range(1, model.nbody):  # parents come before children in MuJoCo's order
+        mask[b] |= mask[model.body_parentid[b]]
+    return mask
+
+
 def _yaw(q: np.ndarray) -> float:
     """Heading (rad) of the root's local +X for a wxyz quaternion."""
     w, x, y, z = q
@@ -348,9 +356,7 @@ class Tracker:
         self.hip_qadr = [model.jnt_qposadr[j] for j in hips]
         # Sole boxes: the box geoms of the feet and the bodies below them (toes), with their
         # 8 corners in the geom frame (the lowest ones are the sole's).
-        below_feet = np.isin(np.arange(model.nbody), self.feet)
-        for b in range(1, model.nbody):  # parents come before children in MuJoCo's order
-            below_feet[b] |= below_feet[model.body_parentid[b]]
+        below_feet = subtree_mask(model, FEET)
         self.sole_geoms = np.flatnonzero(
             below_feet[model.geom_bodyid] & (model.geom_type == mujoco.mjtGeom.mjGEOM_BOX)
         )
@@ -365,12 +371,7 @@ class Tracker:
         self.kp[:2] = s.kp_root_xy
         self.weight = np.ones(nv)
         self.weight[:ROOT_DOF] = s.root_weight
-        leg = np.zeros(model.nbody, bool)
-        for name in THIGHS:
-            leg[model.body(name).id] = True
-        for b in range(1, model.nbody):
-            leg[b] |= leg[model.body_parentid[b]]
-        upper = np.flatnonzero(~leg[model.dof_bodyid])
+        upper = np.flatnonzero(~subtree_mask(model, THIGHS)[model.dof_bodyid])
         self.weight[upper[upper >= ROOT_DOF]] = s.upper_body_weight
         rest = mujoco.MjData(model)
         mujoco.mj_kinematics(model, rest)  # qpos0 stands flat-footed on the floor
