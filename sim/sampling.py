@@ -17,7 +17,8 @@ The cost of a state (:func:`state_cost`) is what predicts a fall a step later, r
 reference at its played clock: the horizontal capture-point error (m), the tilt of the root's
 up axis (degrees), the head's height error (m), and the mean body17 error in the root's frame
 (the pose, m), each divided by its scale in :class:`SearchSettings` and squared. A fallen
-state costs infinity.
+state, or one where MuJoCo met a diverging acceleration (:meth:`Tracker.unstable`), costs
+infinity.
 """
 
 from __future__ import annotations
@@ -109,6 +110,8 @@ def state_cost(
     """Cost of the tracker's current state against the reference at ``progress.clock``
     (module docstring); infinity once fallen."""
     d = tracker.data
+    if tracker.unstable():
+        return np.inf
     clock = min(progress.clock, ref.qpos.shape[0] - 1.0)
     i = min(int(clock), ref.qpos.shape[0] - 2)
     a = clock - i
@@ -169,8 +172,7 @@ def search_track(
         for node in beam:
             for sample in range(samples):
                 offset = np.zeros(m.nu) if sample == 0 else rng.normal(0.0, sigma)
-                mujoco.mj_setState(m, d, node.state, STATE)
-                mujoco.mj_step1(m, d)
+                tracker.restore(node.state, STATE)
                 progress = tracker.advance(ref, node.progress, window, offset)
                 state = np.empty(size)
                 mujoco.mj_getState(m, d, state, STATE)

@@ -515,7 +515,7 @@ class Tracker:
     def result(self, ref: Reference, frames: list[tuple]) -> TrackingResult:
         """The :class:`TrackingResult` of the recorded ``frames`` (one per reference frame)."""
         columns = zip(*frames, strict=True)
-        reference_frame, qpos, sites, torque, power = (np.array(c) for c in columns)
+        reference_frame, qpos, sites, torque, power, unstable = (np.array(c) for c in columns)
         ref_sites = _at_frames(ref.sites, reference_frame)
         qpos_ref = ref.qpos[np.round(reference_frame).astype(int)]
         return TrackingResult(
@@ -523,7 +523,7 @@ class Tracker:
             body17_error=np.linalg.norm(sites - ref_sites, axis=-1),
             torque=torque,
             power=power,
-            fall_frame=self._fall_frame(qpos, qpos_ref, sites, ref_sites),
+            fall_frame=self._fall_frame(qpos, qpos_ref, sites, ref_sites, unstable),
             fps=ref.fps,
             reference_frame=reference_frame,
         )
@@ -545,6 +545,25 @@ class Tracker:
             d.site_xpos[self.sites].copy(),
             d.actuator_force.copy(),
             power,
+            self.unstable(),
+        )
+
+    def restore(self, state: np.ndarray, spec: int) -> None:
+        """Put the simulation back into ``state`` (``mj_getState`` with ``spec``), warnings
+        cleared, ready for :meth:`advance`."""
+        mujoco.mj_setState(self.model, self.data, state, spec)
+        for warning in self.data.warning:
+            warning.number = 0
+        mujoco.mj_step1(self.model, self.data)
+
+    def unstable(self) -> bool:
+        """Whether MuJoCo has met a diverging acceleration or torque since the start. It then
+        resets the state to the model's rest pose and goes on, so the rest of the run is no
+        tracking at all: it counts as a fall from that frame on (:meth:`restore` clears it)."""
+        warnings = self.data.warning
+        return bool(
+            warnings[mujoco.mjtWarning.mjWARN_BADQACC].number
+            or warnings[mujoco.mjtWarning.mjWARN_BADCTRL].number
         )
 
     def _com_jacobian(self):
@@ -679,11 +698,11 @@ class Tracker:
             mujoco.mju_quat2Vel(err, err_quat, 1.0)
             yield jr.copy(), s.kp_foot * err + s.kd_foot * (jr_ref @ v_target - jr @ d.qvel)
 
-    def _fall_frame(self, qpos, qpos_ref, sites, ref_sites) -> int | None:
+    def _fall_frame(self, qpos, qpos_ref, sites, ref_sites, unstable) -> int | None:
         head = BODY17.index("head")
         low = sites[:, head, 2] < self.settings.fall_head_ratio * ref_sites[:, head, 2]
         tilt = np.degrees(np.arccos(np.clip(np.sum(_up(qpos) * _up(qpos_ref), -1), -1, 1)))
-        fallen = np.flatnonzero(low | (tilt > self.settings.fall_tilt_deg))
+        fallen = np.flatnonzero(low | (tilt > self.settings.fall_tilt_deg) | unstable)
         return int(fallen[0]) if fallen.size else None
 
 

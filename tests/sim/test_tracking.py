@@ -111,3 +111,13 @@ def test_looped_clip_continues_the_walk(body):
 def _summary_line(name, result):
     s = result.summary()
     print(name, {k: s[k] for k in ("fell", "fall_time_s", "body17_err_cm_mean")})
+
+
+def test_a_diverging_simulation_counts_as_a_fall(body):
+    """Absurd gains make MuJoCo's accelerations diverge; it then resets the state to the rest
+    pose and goes on, which must not pass for tracking."""
+    walk = generate("walk", duration_s=1.0, fps=30.0)
+    tracker = Tracker(humanoid_model(body), TrackingSettings(kp=1e6, kd=2e3))
+    result = tracker.run(body.qpos_from_motion(walk), walk.fps)
+    assert tracker.unstable()
+    assert result.fall_frame == 1
