@@ -26,7 +26,14 @@ target for the foot and toe bodies (the first pass's heading, no pitch or roll) 
 ankle and toe sites at their heights in the rest pose, which stands flat-footed on the floor;
 on the other frames no foot site goes below that height (toes dug into the floor at toe-off
 would throw the simulated body up). UHC and PhysDiff clean contact the same way: feet in
-stance are put on the ground before physics.
+stance are put on the ground before physics. Three more repairs make a reference the
+simulated feet can walk (Bandai walks: the plain tracker's mean time upright from five start
+frames went from 0.8 to 2.7 s): the source's standing foot pitch (ankle to toe; Bandai 40 deg
+down, the humanoid 17) is matched before the IK (:func:`match_foot_pitch`), else every frame
+tips the foot toes-down; toe joints bend where their box would dip into the floor
+(:func:`lift_toes`); and swinging feet keep their soles :data:`SWING_CLEARANCE_M` up
+(:func:`clear_swing_feet`), since the humanoid's toe box reaches 7 cm beyond the source's
+toe joint and would drag on the floor and trip the body.
 """
 
 from __future__ import annotations
@@ -45,6 +52,7 @@ from avatar_models.errors import MotionValueError, RigError
 from avatar_models.measure import standing_height
 from avatar_models.motion import Motion
 from avatar_models.rigs import body17_positions, load_rig
+from sim.soles import box_corners, corner_positions, sole_boxes, subtree_mask
 
 TEMPLATE_RIG = "avatar"
 FOOT_SITES = (("l_ankle", "l_foot"), ("r_ankle", "r_foot"))
@@ -147,10 +155,11 @@ def retarget(
 ) -> Retargeted:
     """Retarget ``motion`` (any rig with a body17 map) onto ``body`` (default:
     :func:`fitted_body`). Joint limits of the body hold in the result. ``level_feet`` puts
-    stance feet flat on the floor (module docstring), for physics tracking; off by default,
-    since it trades fidelity for it (Bandai walks: body17 residual 0.03 -> 0.42 cm, and the
-    flattened toes press 6-9 cm into the floor at p95 against 1.5 cm without), so the physics
-    checks judge the source's own contacts.
+    stance feet flat on the floor and clears swinging ones (module docstring), for physics
+    tracking; off by default, since it trades fidelity for it (Bandai walk normal_001: mean
+    body17 residual 0.03 -> 0.75 cm, p95 2.4 cm), so the physics checks judge the source's own
+    contacts. The body is the one ``build_body(result.motion.skeleton)`` gives, so a
+    reference levelled for these feet is simulated with the same feet.
 
     Raises:
         MotionValueError: the motion's rig has no body17 map.
@@ -161,19 +170,27 @@ def retarget(
         raise MotionValueError(f"cannot retarget: {exc}") from exc
     fitted = body is None
     if fitted:
-        body = fitted_body(motion)
+        # The body that the result's skeleton builds (build_body(out.motion.skeleton), what
+        # a caller simulates): fitted_body's own segment scaling also sizes geoms (toe box
+        # 1 cm shorter, head, masses), and a reference made for other feet than the
+        # simulated ones puts the toes into the floor.
+        body = build_body(fitted_body(motion).skeleton)
     else:
         targets = targets * (standing_height(body.skeleton) / standing_height(motion))
     model = humanoid_model(body)
+    stance = stance_feet(targets, motion.fps)
+    if level_feet:  # without the floor offset below, flat feet would float (Bandai: 6 cm)
+        targets = match_foot_pitch(model, targets, stance)
     ik = HumanoidIK(model, BODY17, settings=settings)
     solved = ik.solve(targets)
     qpos, residual_cm = solved.qpos, solved.residual_cm
     if level_feet:
-        stance = stance_feet(targets, motion.fps)
         offset = sole_offset(model, targets, stance)
         qpos[:, 2] -= offset
         targets = targets - [0.0, 0.0, offset]
         qpos = level_stance_feet(model, qpos, stance, settings)
+        qpos = lift_toes(model, qpos)
+        qpos = clear_swing_feet(model, qpos, swinging_feet(targets, motion.fps) & ~stance)
         sites = np.stack([ik.frame_positions(q) for q in qpos])
         residual_cm = 100.0 * np.linalg.norm(sites - targets, axis=-1).mean(axis=1)
     out = motion_from_qpos(body, qpos, motion.fps)
@@ -189,6 +206,133 @@ def stance_feet(positions: np.ndarray, fps: float) -> np.ndarray:
     speed = np.linalg.norm(np.gradient(ankle[..., :2], 1.0 / fps, axis=0), axis=-1)
     low = toe_z < toe_z.min(axis=0) + STANCE_HEIGHT_M
     return low & (speed < STANCE_SPEED_M_S)
+
+
+def match_foot_pitch(model, positions: np.ndarray, stance: np.ndarray) -> np.ndarray:
+    """``positions (T, 17, 3)`` with each toe target turned about its ankle so that the
+    source's standing foot (ankle to toe) has the humanoid's flat-footed pitch.
+
+    Rigs place the ankle and toe joints differently within the foot (Bandai: the ankle-to-toe
+    line points 40 deg down in flat stance, the humanoid's 17 deg), so matching the source's
+    toe position rotates the humanoid's foot toes-down by the difference in every frame:
+    heels up in stance, toe boxes centimetres into the floor at toe-off and in swing. The
+    constant difference (median over the ``stance (T, 2)`` frames) is removed by turning
+    the ankle-to-toe vector towards the shank (knee minus ankle) in the leg's plane."""
+    out = positions.copy()
+    rest = HumanoidIK(model, BODY17).frame_positions(model.qpos0)
+    for side, (ankle, toe) in enumerate(FOOT_SITES):
+        a, b, k = INDEX[ankle], INDEX[toe], INDEX[ankle.replace("ankle", "knee")]
+        foot = positions[:, b] - positions[:, a]
+        shank = positions[:, k] - positions[:, a]
+        down = np.arctan2(-foot[:, 2], np.linalg.norm(foot[:, :2], axis=-1))
+        v = rest[b] - rest[a]
+        rest_down = np.arctan2(-v[2], np.linalg.norm(v[:2]))
+        if not stance[:, side].any():
+            continue
+        angle = float(np.median(down[stance[:, side]])) - rest_down
+        axis = np.cross(foot, shank)
+        axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
+        out[:, b] = positions[:, a] + Rotation.from_rotvec(angle * axis).apply(foot)
+    return out
+
+
+def lift_toes(model, qpos: np.ndarray, steps: int = 40) -> np.ndarray:
+    """``(T, nq)`` ``qpos`` with each toe joint's flexion (``:ry``) changed, where its box
+    dips below the floor, to the nearest angle in its range that keeps the box on or above
+    it. Body17 sees the toes only at the ball of the foot, so the IK leaves them straight
+    and a foot pitched at push-off puts its toe tip centimetres into the floor; a real foot
+    bends at the ball. The toes turn about the ball, so no body17 site moves."""
+    out = qpos.copy()
+    data = mujoco.MjData(model)
+    toes = []
+    for j in range(model.njnt):
+        body = model.jnt_bodyid[j]
+        if "Toe" in model.body(body).name and model.joint(j).name.endswith(":ry"):
+            geoms = sole_boxes(model, (model.body(body).name,))
+            if geoms.size:
+                toes.append((geoms[:1], int(model.jnt_qposadr[j]), model.jnt_range[j]))
+
+    def lowest(geom: np.ndarray) -> float:
+        mujoco.mj_kinematics(model, data)
+        return float(corner_positions(data, geom, box_corners(model, geom))[..., 2].min())
+
+    for t in range(out.shape[0]):  # MuJoCo evaluates one configuration per call
+        data.qpos[:] = out[t]
+        for geom, adr, (lo, hi) in toes:
+            if lowest(geom) >= 0.0:
+                continue
+            q0 = data.qpos[adr]
+            grid = np.linspace(lo, hi, steps + 1)
+            heights = np.empty(grid.size)
+            for n, angle in enumerate(grid):
+                data.qpos[adr] = angle
+                heights[n] = lowest(geom)
+            ok = heights >= 0.0
+            data.qpos[adr] = (
+                grid[np.argmin(np.abs(grid - q0) + 1e3 * ~ok)]
+                if ok.any()
+                else grid[np.argmax(heights)]
+            )
+        out[t] = data.qpos
+    return out
+
+
+SWING_CLEARANCE_M = 0.03
+"""A foot off the floor in the source (not standing) keeps its sole boxes this high."""
+
+
+SWING_SPEED_M_S = 1.0
+"""A foot swings while its ball (toe site) moves faster than this horizontally: push-off,
+where the heel rises with the ball still on the floor, is slower."""
+
+
+def swinging_feet(positions: np.ndarray, fps: float) -> np.ndarray:
+    """``(T, 2)`` whether the ball of the left and right foot moves faster than
+    :data:`SWING_SPEED_M_S` horizontally in body17 ``positions (T, 17, 3)``."""
+    ball = positions[:, [INDEX[t] for _, t in FOOT_SITES], :2]
+    return np.linalg.norm(np.gradient(ball, 1.0 / fps, axis=0), axis=-1) > SWING_SPEED_M_S
+
+
+def clear_swing_feet(
+    model, qpos: np.ndarray, swing: np.ndarray, clearance: float = SWING_CLEARANCE_M
+) -> np.ndarray:
+    """``(T, nq)`` ``qpos`` with each foot that swings (``swing (T, 2)``) raised,
+    where its lowest sole-box corner is below ``clearance``, by bending that leg's hinges
+    (damped least squares on the corner's height, the foot's orientation and its
+    horizontal position held). The source's swing foot clears its floor by 2 cm at the toe
+    joint, but the humanoid's toe box reaches 2 cm below and 7 cm beyond that joint, so a
+    swing toe drags along the floor and trips a simulated body."""
+    out = qpos.copy()
+    data = mujoco.MjData(model)
+    legs, boxes = [], []
+    for side in "LR":
+        foot, thigh = f"Bip01 {side} Foot", f"Bip01 {side} Thigh"
+        chain = subtree_mask(model, (thigh,)) & ~subtree_mask(model, (foot,))
+        chain[model.body(foot).id] = True  # thigh to foot, toes left alone
+        legs.append(np.flatnonzero(chain[model.dof_bodyid]))
+        geoms = sole_boxes(model, (foot,))
+        boxes.append((geoms, box_corners(model, geoms)))
+    jac, jrot = np.zeros((3, model.nv)), np.zeros((3, model.nv))
+    for t in range(out.shape[0]):  # MuJoCo evaluates one configuration per call
+        data.qpos[:] = out[t]
+        for side in np.flatnonzero(swing[t]):
+            geoms, corners = boxes[side]
+            for _ in range(10):
+                mujoco.mj_kinematics(model, data)
+                mujoco.mj_comPos(model, data)
+                points = corner_positions(data, geoms, corners)  # (G, 8, 3)
+                g, k = np.unravel_index(np.argmin(points[..., 2]), points.shape[:2])
+                deficit = clearance - points[g, k, 2]
+                if deficit <= 1e-4:
+                    break
+                mujoco.mj_jac(model, data, jac, jrot, points[g, k], model.geom_bodyid[geoms[g]])
+                j = np.vstack([jac, jrot])[:, legs[side]]
+                dq = j.T @ np.linalg.solve(j @ j.T + 1e-4 * np.eye(6), [0, 0, deficit, 0, 0, 0])
+                full = np.zeros(model.nv)
+                full[legs[side]] = dq
+                mujoco.mj_integratePos(model, data.qpos, full, 1.0)
+        out[t] = data.qpos
+    return out
 
 
 def sole_offset(model, positions: np.ndarray, stance: np.ndarray) -> float:

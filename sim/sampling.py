@@ -30,6 +30,7 @@ import numpy as np
 from tqdm import tqdm
 
 from avatar_models.body17 import BODY17
+from sim.soles import subtree_mask
 from sim.tracking import (
     THIGHS,
     Progress,
@@ -38,7 +39,6 @@ from sim.tracking import (
     TrackingResult,
     TrackingSettings,
     _up,
-    subtree_mask,
 )
 
 HEAD = BODY17.index("head")

@@ -63,10 +63,10 @@ from scipy.ndimage import gaussian_filter1d
 
 from avatar_models.body17 import BODY17
 from avatar_models.errors import MotionValueError
+from sim.soles import FEET, box_corners, corner_positions, sole_boxes, subtree_mask
 
 ROOT_DOF = 6
 QP_SOLVER = "daqp"
-FEET = ("Bip01 L Foot", "Bip01 R Foot")
 THIGHS = ("Bip01 L Thigh", "Bip01 R Thigh")
 ANKLE_SITES = ("l_ankle", "r_ankle")
 GRAVITY = 9.81
@@ -245,14 +245,6 @@ def looped(qpos: np.ndarray, fps: float, duration_s: float, min_cycle_s: float =
     return np.vstack(pieces)[:need]
 
 
-def subtree_mask(model: mujoco.MjModel, names: tuple[str, ...]) -> np.ndarray:
-    """``(nbody,)`` bool: the bodies ``names`` and every body below them."""
-    mask = np.isin(np.arange(model.nbody), [model.body(name).id for name in names])
-    for b in range(1, model.nbody):  # parents come before children in MuJoCo's order
-        mask[b] |= mask[model.body_parentid[b]]
-    return mask
-
-
 def _yaw(q: np.ndarray) -> float:
     """Heading (rad) of the root's local +X for a wxyz quaternion."""
     w, x, y, z = q
@@ -356,14 +348,10 @@ class Tracker:
         self.hip_qadr = [model.jnt_qposadr[j] for j in hips]
         # Sole boxes: the box geoms of the feet and the bodies below them (toes), with their
         # 8 corners in the geom frame (the lowest ones are the sole's).
-        below_feet = subtree_mask(model, FEET)
-        self.sole_geoms = np.flatnonzero(
-            below_feet[model.geom_bodyid] & (model.geom_type == mujoco.mjtGeom.mjGEOM_BOX)
-        )
+        self.sole_geoms = sole_boxes(model)
         if self.sole_geoms.size == 0:
             raise MotionValueError("tracking needs box feet (the sole corners are contacts)")
-        signs = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T
-        self.sole_corners = signs[None] * model.geom_size[self.sole_geoms][:, None]  # (G, 8, 3)
+        self.sole_corners = box_corners(model, self.sole_geoms)  # (G, 8, 3)
         nv = model.nv
         self.kp = np.full(nv, s.kp)
         self.kd = np.full(nv, s.kd)
@@ -660,9 +648,7 @@ class Tracker:
         on one foot MuJoCo often reports 1-3 points, which leaves the QP a support polygon
         too small to push the body sideways; the corners span the whole sole."""
         m, d = self.model, self.data
-        centre = d.geom_xpos[self.sole_geoms]  # (G, 3)
-        axes = d.geom_xmat[self.sole_geoms].reshape(-1, 3, 3)
-        corners = centre[:, None] + np.einsum("gij,gkj->gki", axes, self.sole_corners)
+        corners = corner_positions(d, self.sole_geoms, self.sole_corners)
         touching = np.isin(self.sole_geoms, d.contact.geom[: d.ncon])  # MuJoCo's contacts
         near = (corners[..., 2] < self.settings.contact_margin) & touching[:, None]  # (G, 8)
         geom, corner = np.nonzero(near)
