@@ -2,15 +2,26 @@
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 import pytest
 
 from avatar_models.body import build_body
+from avatar_models.body.ik import HumanoidIK, humanoid_model
+from avatar_models.body17 import BODY17
 from avatar_models.errors import MotionValueError
 from avatar_models.formats import load_motion
 from avatar_models.generator import Subject, generate
-from avatar_models.rigs import body17_positions
-from sim.retarget import fitted_body, retarget
+from avatar_models.rigs import body17_positions, load_rig
+from sim.retarget import (
+    SWING_CLEARANCE_M,
+    fitted_body,
+    lift_toes,
+    retarget,
+    stance_feet,
+    swinging_feet,
+)
+from sim.soles import FEET, box_corners, corner_positions, sole_boxes
 
 BANDAI_WALK = "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh"
 
@@ -72,3 +83,55 @@ def test_real_mocap_retargets_under_2cm(mocap_dir, clip):
     print(f"{clip}: residual mean {residual_cm.mean():.2f} cm, p95 {p95:.2f} cm")
     assert residual_cm.mean() < 2.0
     assert out.skeleton.name == "avatar"
+
+
+def _lowest_sole_corners(body, qpos: np.ndarray) -> np.ndarray:
+    """``(T, 2)`` height of the lowest sole-box corner of the left and right foot."""
+    model = humanoid_model(body)
+    data = mujoco.MjData(model)
+    boxes = [sole_boxes(model, (foot,)) for foot in FEET]
+    low = np.empty((qpos.shape[0], 2))
+    for t, q in enumerate(qpos):  # MuJoCo evaluates one configuration per call
+        data.qpos[:] = q
+        mujoco.mj_kinematics(model, data)
+        for side, geoms in enumerate(boxes):
+            low[t, side] = corner_positions(data, geoms, box_corners(model, geoms))[..., 2].min()
+    return low
+
+
+def test_levelled_real_walk_stands_flat_and_swings_clear(mocap_dir):
+    """With ``level_feet`` the Bandai walk stands on flat soles, lifts its swinging soles
+    3 cm clear (so a simulated toe does not catch the floor) and digs into the floor nowhere
+    by more than the toes' range allows (1.2 cm), on the body its skeleton builds."""
+    motion = load_motion(mocap_dir / BANDAI_WALK)
+    qpos, out, residual_cm = retarget(motion, level_feet=True)
+    assert residual_cm.mean() < 1.0
+    targets = body17_positions(motion)
+    stance = stance_feet(targets, motion.fps)
+    swing = swinging_feet(targets, motion.fps) & ~stance
+    low = _lowest_sole_corners(build_body(out.skeleton), qpos)
+    assert stance.sum() > 100 and swing.sum() > 100
+    assert np.all((low[stance] > -0.002) & (low[stance] < 0.015))
+    assert np.all(low[swing] > SWING_CLEARANCE_M - 0.001)
+    assert low.min() > -0.015
+    plain = _lowest_sole_corners(build_body(out.skeleton), retarget(motion).qpos)
+    assert plain[swing].min() < SWING_CLEARANCE_M - 0.01  # the clearance is the repair's
+
+
+def test_toes_bend_out_of_the_floor_about_the_ball():
+    """Standing flat with the left toes bent 30 deg into the floor: lift_toes bends them
+    back until the box is out (the nearest such angle, so not further than flat), and no
+    body17 site moves."""
+    body = build_body(load_rig("avatar").skeleton)
+    model = humanoid_model(body)
+    toe = model.jnt_qposadr[model.joint("Bip01 L Toe0:ry").id]
+    bent = [model.qpos0.copy(), model.qpos0.copy()]
+    bent[0][toe], bent[1][toe] = np.radians(30.0), np.radians(-30.0)
+    qpos = np.array(bent)
+    into = qpos[np.argmin(_lowest_sole_corners(body, qpos)[:, 0])][None]
+    assert _lowest_sole_corners(body, into)[0, 0] < -0.01
+    lifted = lift_toes(model, into)
+    assert -1e-3 < _lowest_sole_corners(body, lifted)[0, 0] < 0.01
+    assert abs(lifted[0, toe]) < abs(into[0, toe])
+    ik = HumanoidIK(model, BODY17)
+    np.testing.assert_allclose(ik.frame_positions(lifted[0]), ik.frame_positions(into[0]))
