@@ -15,10 +15,10 @@ produced (``mj_getState`` / ``mj_setState``). The search only chooses the target
 
 The cost of a state (:func:`state_cost`) is what predicts a fall a step later, relative to the
 reference at its played clock: the horizontal capture-point error (m), the tilt of the root's
-up axis (degrees), the head's height error (m), and the mean body17 error in the root's frame
-(the pose, m), each divided by its scale in :class:`SearchSettings` and squared. A fallen
-state, or one where MuJoCo met a diverging acceleration (:meth:`Tracker.unstable`), costs
-infinity.
+up axis (degrees) and its roll and pitch rate error (degrees/s), the head's height error (m),
+and the mean body17 error in the root's frame (the pose, m), each divided by its scale in
+:class:`SearchSettings` and squared. A fallen state, or one where MuJoCo met a diverging
+acceleration (:meth:`Tracker.unstable`), costs infinity.
 """
 
 from __future__ import annotations
@@ -55,7 +55,8 @@ class SearchSettings:
         beam: states kept after each window.
         sigma_rad, sigma_leg_rad: standard deviation of the target offsets, upper body and
             legs (hips, knees, ankles, toes).
-        capture_scale_m, tilt_scale_deg, head_scale_m, pose_scale_m: cost scales.
+        capture_scale_m, tilt_scale_deg, spin_scale_deg_s, head_scale_m, pose_scale_m: cost
+            scales.
         retry_factor, max_backtracks: what is done when every sample falls
             (:func:`search_track`).
         seed: random generator seed (the search is deterministic for a seed).
@@ -68,6 +69,7 @@ class SearchSettings:
     sigma_leg_rad: float = 0.08
     capture_scale_m: float = 0.05
     tilt_scale_deg: float = 5.0
+    spin_scale_deg_s: float = 45.0
     head_scale_m: float = 0.05
     pose_scale_m: float = 0.05
     retry_factor: int = 4
@@ -132,9 +134,15 @@ def state_cost(
         (d.site_xpos[tracker.sites] - d.site_xpos[root]) - (sites - sites[BODY17.index("pelvis")]),
         axis=1,
     ).mean()
+    # Roll and pitch rates of the root (its local x, y), which the capture point (linear
+    # momentum) does not see: a body upright now but rotating fast falls a window later.
+    spin = np.degrees(
+        np.linalg.norm(d.qvel[3:5] - ((1 - a) * ref.qvel[i] + a * ref.qvel[i + 1])[3:5])
+    )
     return float(
         (capture / search.capture_scale_m) ** 2
         + (tilt / search.tilt_scale_deg) ** 2
+        + (spin / search.spin_scale_deg_s) ** 2
         + (head / search.head_scale_m) ** 2
         + (pose / search.pose_scale_m) ** 2
     )
@@ -154,9 +162,9 @@ def search_track(
 
     When every sample of a window falls, the window is sampled again with
     :attr:`SearchSettings.retry_factor` times as many samples; when those fall too, the search
-    steps back one window and samples that one more widely (at most
-    :attr:`SearchSettings.max_backtracks` times in all). If nothing survives even then, the
-    path that fell last is returned (its result says when it fell)."""
+    steps back one window (two after a second failure in a row, and so on) and samples from
+    there again (at most :attr:`SearchSettings.max_backtracks` times in all). If nothing
+    survives even then, the path that fell last is returned (its result says when it fell)."""
     search = search or SearchSettings()
     tracker = Tracker(model, settings)
     m, d = tracker.model, tracker.data
@@ -186,6 +194,7 @@ def search_track(
     mujoco.mj_getState(m, d, state, STATE)
     history = [[_Node(0.0, state, start, ())]]  # the beam after each window
     simulated, backtracks, last_fallen = 0, 0, history[0][0]
+    furthest, depth = 1, 1  # windows reached; how far the next step back goes
     bar = tqdm(total=tracker.steps_of(ref), unit="step", disable=not progress_bar, leave=False)
     while not tracker.finished(ref, history[-1][0].progress):
         samples, children = search.samples, []
@@ -199,10 +208,15 @@ def search_track(
             last_fallen = children[0]
             if backtracks >= search.max_backtracks or len(history) == 1:
                 break
+            # The fall may have been decided several windows back: each failure in a row
+            # steps back one window further.
             backtracks += 1
-            history.pop()
+            del history[max(1, len(history) - depth) :]
+            depth += 1
             continue
         history.append([c for c in children if np.isfinite(c.cost)][: search.beam])
+        if len(history) > furthest:
+            furthest, depth = len(history), 1
         bar.update(history[-1][0].progress.step - bar.n)
     bar.close()
     best = history[-1][0] if tracker.finished(ref, history[-1][0].progress) else last_fallen
