@@ -63,7 +63,7 @@ from scipy.ndimage import gaussian_filter1d
 
 from avatar_models.body17 import BODY17
 from avatar_models.errors import MotionValueError
-from sim.soles import FEET, box_corners, corner_positions, sole_boxes, subtree_mask
+from sim.soles import FEET, box_corners, corner_positions, sole_boxes
 
 ROOT_DOF = 6
 QP_SOLVER = "daqp"
@@ -134,10 +134,6 @@ class TrackingSettings:
     control_period: int = 5
     fall_head_ratio: float = 0.6
     fall_tilt_deg: float = 60.0
-    ankle_height_weight: float = 0.0
-    upper_body_weight: float = 1.0
-    kp_ankle: float = 100.0
-    kd_ankle: float = 20.0
 
 
 @dataclass(frozen=True)
@@ -278,8 +274,6 @@ class Reference:
         swing: ``(T, 2)`` foot-placement weights (:meth:`Tracker.swing_weights`).
         sites: ``(T, 17, 3)`` body17 site positions.
         com: ``(T, 3, 3)`` whole-body centre of mass position, velocity, acceleration.
-        ankle_height: ``(T, 3, 2)`` height of the ankle sites (left, right), its velocity
-            and acceleration.
     """
 
     qpos: np.ndarray
@@ -289,7 +283,6 @@ class Reference:
     swing: np.ndarray
     sites: np.ndarray
     com: np.ndarray
-    ankle_height: np.ndarray
     fps: float
 
 
@@ -359,8 +352,6 @@ class Tracker:
         self.kp[:2] = s.kp_root_xy
         self.weight = np.ones(nv)
         self.weight[:ROOT_DOF] = s.root_weight
-        upper = np.flatnonzero(~subtree_mask(model, THIGHS)[model.dof_bodyid])
-        self.weight[upper[upper >= ROOT_DOF]] = s.upper_body_weight
         rest = mujoco.MjData(model)
         mujoco.mj_kinematics(model, rest)  # qpos0 stands flat-footed on the floor
         self.sole_normal = [rest.xmat[b].reshape(3, 3)[2] for b in self.feet]  # R^T z
@@ -427,9 +418,6 @@ class Tracker:
             swing=self.swing_weights(qpos_ref, fps),
             sites=self.reference_sites(qpos_ref),
             com=_with_derivatives(self.reference_com(qpos_ref), fps),
-            ankle_height=_with_derivatives(
-                self._site_positions(qpos_ref, self.ankles)[..., 2], fps
-            ),
             fps=fps,
         )
 
@@ -486,7 +474,6 @@ class Tracker:
                 if target_offset is not None:
                     q_target[self.hinge_qadr] += target_offset
                 standing = (swinging == 0) & s.level_stance_feet
-                self._ankle_target = (1 - a) * ref.ankle_height[i] + a * ref.ankle_height[i + 1]
                 tau = self._torques(q_target, v_target, a_target, com, standing)
             d.ctrl[:] = tau
             mujoco.mj_step2(m, d)
@@ -608,18 +595,6 @@ class Tracker:
         for jr, acc in self._foot_tasks(q_target, v_target, standing):
             hess[:nv, :nv] += s.foot_weight * jr.T @ jr
             grad[:nv] -= s.foot_weight * jr.T @ acc
-        if s.ankle_height_weight > 0:
-            jz = np.zeros((3, nv))
-            for side, site in enumerate(self.ankles):
-                mujoco.mj_jacSite(m, d, jz, None, site)
-                z, vz, az = self._ankle_target[:, side]
-                acc = (
-                    az
-                    + s.kp_ankle * (z - d.site_xpos[site, 2])
-                    + s.kd_ankle * (vz - jz[2] @ d.qvel)
-                )
-                hess[:nv, :nv] += s.ankle_height_weight * np.outer(jz[2], jz[2])
-                grad[:nv] -= s.ankle_height_weight * jz[2] * acc
         jcom, wcom = self._jac_com, np.asarray(s.com_weight)[:, None]
         com_acc = (
             com[2] + s.kp_com * (com[0] - d.subtree_com[0]) + s.kd_com * (com[1] - jcom @ d.qvel)
