@@ -63,8 +63,8 @@ class SearchSettings:
     """
 
     window_s: float = 0.2
-    samples: int = 4
-    beam: int = 4
+    samples: int = 8
+    beam: int = 6
     sigma_rad: float = 0.03
     sigma_leg_rad: float = 0.08
     capture_scale_m: float = 0.05

@@ -36,8 +36,8 @@ def register(app: typer.Typer) -> None:
         plain: Annotated[
             bool, typer.Option("--plain", help="The controller alone, no sampling search.")
         ] = False,
-        samples: Annotated[int, typer.Option(help="Search: samples per kept state.")] = 4,
-        beam: Annotated[int, typer.Option(help="Search: states kept per window.")] = 4,
+        samples: Annotated[int, typer.Option(help="Search: samples per kept state.")] = 8,
+        beam: Annotated[int, typer.Option(help="Search: states kept per window.")] = 6,
         out: Annotated[Path, typer.Option(help="Folder for CSV, JSON and plot.")] = Path(
             "out/track"
         ),

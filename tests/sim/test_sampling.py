@@ -28,7 +28,7 @@ def test_search_walks_and_its_path_replays_exactly_without_root_forces(body):
     assert not searched.result.fell, searched.result.summary()
     assert searched.offsets.shape == (15, humanoid_model(body).nu)  # 3 s in 0.2 s windows
     assert np.any(searched.offsets)  # some window chose a sampled offset
-    assert searched.simulated_s >= 4 * 3.0  # every kept state sampled 4 times
+    assert searched.simulated_s >= 8 * 3.0  # every kept state sampled 8 times
     again = replay(
         _RootWatch(humanoid_model(body)), qpos, walk.fps, searched.offsets, searched.window_steps
     )
@@ -61,7 +61,6 @@ def test_searched_walk_10_s_without_falling(body, seed):
 
 @pytest.mark.slow
 @pytest.mark.mocap
-@pytest.mark.xfail(strict=True, reason="retargeted Bandai walk: every sample falls by ~1 s")
 def test_searched_bandai_walk_10_s_without_falling(mocap_dir):
     from avatar_models.formats import load_motion
     from sim.retarget import retarget
