@@ -234,3 +234,28 @@ def test_generated_walk_rolls_over_the_toes_without_sinking_into_the_floor():
     # A rigid heel-to-toe box sank about 3 cm at push-off, a sole reaching behind the heel
     # joint (the pivot of the heel rocker) 3.6 mm after heel strike.
     assert deepest.max() < 0.001
+
+
+def test_wrist_twist_is_replayed_as_forearm_rotation():
+    """CMU carries pronation/supination as the wrist joint's twist about the forearm; the
+    qpos puts it on the elbow's axial hinge, the hand's pose unchanged."""
+    sk = load_rig("cmu").skeleton
+    frames, twist = 5, np.radians(np.linspace(-70.0, 70.0, 5))
+    rot = np.tile(quat.IDENTITY, (frames, sk.n_joints, 1))
+    elbow, wrist = sk.index("RightForeArm"), sk.index("RightHand")
+    rot[:, elbow] = quat.from_axis_angle(np.array([0.0, 0.0, 1.0]), np.full(frames, 1.2))
+    rot[:, wrist] = quat.from_axis_angle(sk.offsets[wrist], twist)
+    motion = Motion(sk, 30.0, np.tile([0.0, 0.0, 1.0], (frames, 1)), rot)
+    body = build_body(sk)
+    model, data = _model(body)
+    qpos = body.qpos_from_motion(motion)
+    hinge = {h: 7 + i for i, h in enumerate(body.hinges)}
+    np.testing.assert_allclose(qpos[:, [hinge[(wrist, a)] for a in "xyz"]], 0.0, atol=1e-9)
+    # The right forearm points along -Y, so a twist about its bone is -ry.
+    np.testing.assert_allclose(qpos[:, hinge[(elbow, "y")]], -twist, atol=1e-9)
+    expected = motion.global_rotations()[:, wrist]
+    for t in range(frames):
+        data.qpos[:] = qpos[t]
+        mujoco.mj_kinematics(model, data)
+        got = data.xquat[model.body("RightHand").id]
+        assert abs(np.dot(got, expected[t])) == pytest.approx(1.0, abs=1e-9)
