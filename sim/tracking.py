@@ -629,7 +629,9 @@ class Tracker:
         too small to push the body sideways; the corners span the whole sole."""
         m, d = self.model, self.data
         corners = corner_positions(d, self.sole_geoms, self.sole_corners)
-        touching = np.isin(self.sole_geoms, d.contact.geom[: d.ncon])  # MuJoCo's contacts
+        in_contact = np.zeros(m.ngeom, bool)
+        in_contact[d.contact.geom[: d.ncon].ravel()] = True  # MuJoCo's contacts
+        touching = in_contact[self.sole_geoms]
         near = (corners[..., 2] < self.settings.contact_margin) & touching[:, None]  # (G, 8)
         geom, corner = np.nonzero(near)
         points = corners[geom, corner]
