@@ -28,7 +28,8 @@ skating are measured in the floor frame (floor at z = 0, Z up):
   humanoid's foot is one rigid box without a toe joint, so the sole's points move during
   push-off even in clean mocap (CMU running: stance median 18-25 cm/s); the median threshold
   (40 cm/s) leaves room for that, the slide threshold (10 cm per stance) catches slow drift.
-- **joint limits**: a hinge beyond its anatomical range (the body's AAOS ranges) by more than
+- **joint limits**: a hinge, or the total rotation of a chain of joints sharing one range (the
+  spine's, the neck's), beyond its anatomical range (the body's AAOS ranges) by more than
   ``limit_tolerance_deg``; the clip's value is the share of frames with any such hinge. AAOS
   ranges are population averages with standard deviations of 5-10 degrees (Soucie et al.
   2011, Haemophilia 17(3):500-507), so 20 degrees (about 2 SD) is the tolerance; hinges

@@ -46,7 +46,6 @@ class Anatomy:
         simulated: ``(J,)`` bool, joints that get a MuJoCo body.
         roles: role of each simulated non-root joint (index -> role), the root has ``"root"``.
         sides: ``"left"``, ``"right"`` or ``"center"`` per joint.
-        chain_lengths: per simulated joint, how many joints share its role on its chain.
         bone_kind: ``(J,)`` segment kind of the bone from each joint's parent to it
             (``""`` for the root).
         body_of: ``(J,)`` index of the simulated joint whose body carries each joint.
@@ -56,7 +55,6 @@ class Anatomy:
     simulated: np.ndarray
     roles: dict[int, str]
     sides: tuple[str, ...]
-    chain_lengths: dict[int, int]
     bone_kind: tuple[str, ...]
     body_of: np.ndarray
     body17: dict[str, int]
@@ -104,10 +102,6 @@ def classify(skeleton: Skeleton, rig: Rig) -> Anatomy:
     simulated = np.zeros(skeleton.n_joints, bool)
     simulated[list(roles)] = True
 
-    chain_lengths = {
-        j: sum(roles.get(k) == roles[j] for k in skeleton.chain(j) + _descendants(skeleton, j))
-        for j in roles
-    }
     bone_kind = [""] * skeleton.n_joints
     body_of = np.arange(skeleton.n_joints)
     for c in range(1, skeleton.n_joints):
@@ -123,14 +117,4 @@ def classify(skeleton: Skeleton, rig: Rig) -> Anatomy:
             bone_kind[c] = "torso"
         else:
             bone_kind[c] = _BONE_KIND.get(roles[p], "pelvis")
-    return Anatomy(simulated, roles, tuple(sides), chain_lengths, tuple(bone_kind), body_of, b)
-
-
-def _descendants(skeleton: Skeleton, j: int) -> list[int]:
-    """All joints below ``j`` (parents come before children, so one pass suffices)."""
-    below = np.zeros(skeleton.n_joints, bool)
-    below[j] = True
-    for c in range(j + 1, skeleton.n_joints):
-        below[c] = below[skeleton.parents[c]]
-    below[j] = False
-    return list(np.flatnonzero(below))
+    return Anatomy(simulated, roles, tuple(sides), tuple(bone_kind), body_of, b)

@@ -21,7 +21,7 @@ from avatar_models.body import anthropometry as anthro
 from avatar_models.body.anatomy import Anatomy, classify
 from avatar_models.body.errors import BodyError
 from avatar_models.body.geometry import Segment
-from avatar_models.body.joint_ranges import euler_order, joint_ranges
+from avatar_models.body.joint_ranges import euler_order, is_shared, joint_ranges
 from avatar_models.errors import RigError
 from avatar_models.motion import Motion
 from avatar_models.rigs import Rig, identify_rig
@@ -99,11 +99,26 @@ class BodyDescription:
     def hinge_ranges(self) -> dict[int, dict[str, tuple[float, float]]]:
         """Radians per axis for every simulated non-root joint (``{joint: {"x": (lo, hi)}}``)."""
         a = self.anatomy
-        return {
-            j: joint_ranges(role, a.sides[j], a.chain_lengths[j])
-            for j, role in a.roles.items()
-            if role != "root"
-        }
+        return {j: joint_ranges(role, a.sides[j]) for j, role in a.roles.items() if role != "root"}
+
+    @cached_property
+    def chains(self) -> tuple[tuple[int, ...], ...]:
+        """Runs of two or more consecutive simulated joints (each the parent of the next) of
+        one shared role, e.g. CMU's ``(Neck, Neck1, Head)``: one anatomical joint whose range
+        (:attr:`hinge_ranges` of any of them) limits their total rotation (judged exactly by
+        :mod:`sim.checks.joint_limits`; the MJCF limits the sum of their angles per axis)."""
+        roles = self.anatomy.roles
+        runs: dict[int, list[int]] = {}  # first joint of a run -> the run
+        first: dict[int, int] = {}
+        for j in self.body_order[1:]:
+            p = int(self.skeleton.parents[j])
+            if roles[j] == roles.get(p) and p in first and runs[first[p]][-1] == p:
+                first[j] = first[p]
+                runs[first[j]].append(j)
+            elif is_shared(roles[j]):
+                first[j] = j
+                runs[j] = [j]
+        return tuple(tuple(r) for r in runs.values() if len(r) > 1)
 
     @cached_property
     def subtree_mass(self) -> np.ndarray:

@@ -37,15 +37,23 @@ axial rotation, the pelvic girdle, toe abduction and axial rotation) get a small
 the hinge still exists for exact kinematic replay; joints between the skeleton root and the
 pelvis are part of the free root and get the full circle.
 
-The spine and the neck are chains of several joints in most rigs; their ranges are the whole
-chain's, and :func:`joint_ranges` divides them evenly over the chain's joints.
+The spine and the neck are chains of several joints in most rigs (CMU: LowerBack, Spine,
+Spine1 and Neck, Neck1, Head). A shared role's range is the whole chain's: it limits the
+chain's total rotation, that of its last segment relative to the segment above the chain
+(:attr:`~avatar_models.body.description.BodyDescription.chains`). It is not divided over the
+chain's joints: real rigs distribute a bend unevenly and even oppositely (CMU 14_33's neck: the
+lower neck at -19 degrees, the upper neck at +37, the head at +16, 34 in all), so each joint
+gets the whole range, the most any part of the chain can bend, and the chain's total is
+limited on its own (the chain check of :mod:`sim.checks.joint_limits`; in the MJCF a fixed
+tendon limits the sum of the chain's angles per axis, the total to first order).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-# role -> (Euler order of the hinges, {axis: (lo, hi) degrees, left side}, shared by a chain)
+# role -> (Euler order of the hinges, {axis: (lo, hi) degrees, left side}, shared by a chain:
+# consecutive joints of the role form one anatomical joint whose range limits their sum)
 ROLE_TABLE: dict[str, tuple[str, dict[str, tuple[float, float]], bool]] = {
     "root_chain": ("YXZ", {"x": (-180, 180), "y": (-180, 180), "z": (-180, 180)}, False),
     "spine": ("YXZ", {"x": (-35, 35), "y": (-25, 80), "z": (-45, 45)}, True),
@@ -73,21 +81,24 @@ def euler_order(role: str) -> str:
     return ROLE_TABLE[role][0]
 
 
-def joint_ranges(role: str, side: str, chain_length: int) -> dict[str, tuple[float, float]]:
-    """Hinge ranges in radians, ``{axis: (lo, hi)}``, of one joint.
+def is_shared(role: str) -> bool:
+    """Whether consecutive joints of ``role`` form one anatomical joint (spine, neck...)."""
+    return ROLE_TABLE[role][2]
+
+
+def joint_ranges(role: str, side: str) -> dict[str, tuple[float, float]]:
+    """Hinge ranges in radians, ``{axis: (lo, hi)}``, of one joint of ``role`` (for a shared
+    role also the range of the chain's total, see the module).
 
     Args:
         role: a key of :data:`ROLE_TABLE`.
         side: ``"left"``, ``"right"`` or ``"center"`` (centre joints use the left ranges,
             which are symmetric for every centre role).
-        chain_length: number of joints of this role on the joint's chain; shared roles
-            divide their range by it.
     """
-    _, degrees, shared = ROLE_TABLE[role]
-    divisor = max(chain_length, 1) if shared else 1
+    _, degrees, _ = ROLE_TABLE[role]
     out = {}
     for axis, (lo, hi) in degrees.items():
         if side == "right" and axis in ("x", "z"):
             lo, hi = -hi, -lo
-        out[axis] = (float(np.radians(lo / divisor)), float(np.radians(hi / divisor)))
+        out[axis] = (float(np.radians(lo)), float(np.radians(hi)))
     return out

@@ -5,7 +5,13 @@ offset (rest local rotations are the identity, so no body ``quat``). The root bo
 free joint; every other body three hinges about its local x, y, z axes, declared in the
 joint's Euler order so that ``R = R_a(q_a) R_b(q_b) R_c(q_c)`` (MuJoCo composes a body's
 joints in declaration order) equals the skeleton's local rotation. Each hinge has its
-anatomical range and a position actuator.
+anatomical range and a position actuator. A chain of joints that share one anatomical range
+(:attr:`~avatar_models.body.description.BodyDescription.chains`: spine, neck) has that range
+on each of its hinges and, per axis, a limited fixed tendon (:func:`chain_name`) whose length
+is the sum of the chain's angles about that axis: the chain's total (to first order; exactly
+for a bend about one axis) stays within the range however the rig distributes it over the
+joints, while no single joint's share of it is fixed (physics can follow a rig that bends one
+neck joint against the others).
 
 Actuator gains: ``kp = 4 g m H / 2``, i.e. a load of mass ``m`` at half the stature ``H``
 (about the height of the body's centre of mass) deflects the joint by at most a quarter
@@ -39,6 +45,12 @@ SEGMENT_RGBA = "0.8 0.6 0.45 1"
 def hinge_name(joint_name: str, axis: str) -> str:
     """MuJoCo name of the hinge of skeleton joint ``joint_name`` about local ``axis``."""
     return f"{joint_name}:r{axis}"
+
+
+def chain_name(joint_names, axis: str) -> str:
+    """MuJoCo name of the fixed tendon summing a chain's hinges about ``axis``
+    (``"Neck+Neck1+Head:ry"``)."""
+    return f"{'+'.join(joint_names)}:r{axis}"
 
 
 def body_mjcf(desc: BodyDescription) -> str:
@@ -133,6 +145,16 @@ def _model_without_exclusions(desc: BodyDescription) -> ET.Element:
     for name, j in desc.anatomy.body17.items():
         carrier = int(desc.anatomy.body_of[j])
         ET.SubElement(bodies[carrier], "site", name=name, pos=_fmt(rest[j] - rest[carrier]))
+    if desc.chains:
+        tendon = ET.SubElement(root, "tendon")
+        for chain in desc.chains:
+            names = [sk.names[j] for j in chain]
+            for axis, (lo, hi) in desc.hinge_ranges[chain[0]].items():
+                fixed = ET.SubElement(
+                    tendon, "fixed", name=chain_name(names, axis), range=_fmt([lo, hi])
+                )
+                for name in names:
+                    ET.SubElement(fixed, "joint", joint=hinge_name(name, axis), coef="1")
     root.append(actuator)
     return root
 

@@ -259,3 +259,22 @@ def test_wrist_twist_is_replayed_as_forearm_rotation():
         mujoco.mj_kinematics(model, data)
         got = data.xquat[model.body("RightHand").id]
         assert abs(np.dot(got, expected[t])) == pytest.approx(1.0, abs=1e-9)
+
+
+def test_chain_tendons_limit_the_sum_of_the_chains_hinges():
+    """CMU's neck (Neck, Neck1, Head): each hinge has the whole cervical range, a fixed tendon
+    per axis sums the three hinges and has that range too."""
+    body = build_body(load_rig("cmu").skeleton)
+    model, data = _model(body)
+    names = ("Neck", "Neck1", "Head")
+    tendon = model.tendon("Neck+Neck1+Head:ry")
+    assert model.tendon_limited[tendon.id]
+    assert np.degrees(model.tendon_range[tendon.id]) == pytest.approx([-45, 45])
+    for n in names:
+        assert np.degrees(model.joint(hinge_name(n, "y")).range) == pytest.approx([-45, 45])
+    for n, angle in zip(names, (-0.3, 0.6, 0.25), strict=True):
+        data.qpos[model.joint(hinge_name(n, "y")).qposadr[0]] = angle
+    mujoco.mj_kinematics(model, data)
+    mujoco.mj_tendon(model, data)
+    assert data.ten_length[tendon.id] == pytest.approx(0.55)
+    assert model.ntendon == 3 * len(body.chains) == 6  # spine and neck, x y z each

@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+import mujoco
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
+from avatar_models import quat
 from avatar_models.body import build_body
 from avatar_models.generator import generate
 from avatar_models.motion import Motion
+from sim.checks.joint_limits import JointLimits
+from sim.checks.replay import BodyReplay
 from sim.checks.residual import cone_distance
 from sim.checks.skating import contact_runs
 from sim.plausibility import check_motion
@@ -105,3 +110,45 @@ def test_support_margin_is_translation_invariant_and_nan_without_support():
     far = np.array([80.0, -40.0])  # a minute of walking away from the origin
     np.testing.assert_allclose(outside_margin(points + far, active, com + far), near, atol=1e-9)
     assert np.isnan(near[7]) and np.isfinite(np.delete(near, 7)).all()
+
+
+def _joint_limits(body, bends_deg: dict[str, tuple[float, str]]):
+    """The joint-limit check of the rest pose with joints bent ``{joint: (degrees, axis)}``."""
+    m = still_pose(body, 0.0, frames=4)
+    rot = m.local_rot.copy()
+    for name, (deg, axis) in bends_deg.items():
+        rot[:, body.skeleton.index(name)] = quat.from_scipy(
+            Rotation.from_euler(axis, deg, degrees=True)
+        )
+    m = m.replace(local_rot=rot)
+    model = mujoco.MjModel.from_xml_string(body.to_mjcf())
+    replay = BodyReplay.run(body, model, body.qpos_from_motion(m), m.fps, CheckConfig())
+    return JointLimits()(replay, CheckConfig())
+
+
+def test_neck_chain_is_judged_by_its_total_not_by_each_joints_share(rest_body):
+    """The avatar's neck (Bip01 Neck, Bip01 Head) shares the cervical range, flexion 45: one
+    joint bent 60 against the other's -25 (35 in all, as CMU's neck joints bend against
+    each other) passes; both bent 45 (90 in all) fails as the chain, by 45 degrees, though
+    each is within the range alone."""
+    neck, head = "Bip01 Neck", "Bip01 Head"
+    opposite = _joint_limits(rest_body, {neck: (-25.0, "y"), head: (60.0, "y")})
+    assert opposite.values["joint_limit_violation_frac"] == 0.0
+    assert opposite.values["limit_excess_deg_max"] == pytest.approx(15.0)  # head: 60 vs 45
+    too_far = _joint_limits(rest_body, {neck: (45.0, "y"), head: (45.0, "y")})
+    assert too_far.values["joint_limit_violation_frac"] == 1.0
+    ((name, v),) = too_far.details["violations"].items()
+    assert name == f"{neck}+{head}:ry"
+    assert v["max_deg"] == pytest.approx(45.0) and v["angles_deg_at_max"] == pytest.approx([45, 45])
+    # Lateral bending (about x) of the spine chain (35 in all): 3 x 20 = 60 is 25 beyond.
+    spine = {f"Bip01 Spine{s}": (20.0, "x") for s in ("", "1", "2")}
+    side = _joint_limits(rest_body, spine).details["violations"]
+    assert list(side) == ["Bip01 Spine+Bip01 Spine1+Bip01 Spine2:rx"]
+    assert side["Bip01 Spine+Bip01 Spine1+Bip01 Spine2:rx"]["max_deg"] == pytest.approx(25.0)
+
+
+def test_single_joint_keeps_its_own_limit(rest_body):
+    """A joint alone on its role (the knee) is judged by its own range: flexion 135 + 30."""
+    r = _joint_limits(rest_body, {"Bip01 L Calf": (165.0, "y")})
+    assert list(r.details["violations"]) == ["Bip01 L Calf:ry"]
+    assert r.details["violations"]["Bip01 L Calf:ry"]["max_deg"] == pytest.approx(30.0)
