@@ -17,8 +17,8 @@ The cost of a state (:func:`state_cost`) is what predicts a fall a step later, r
 reference at its played clock: the horizontal capture-point error (m), the tilt of the root's
 up axis (degrees) and its roll and pitch rate error (degrees/s), the head's height error (m),
 and the mean body17 error in the root's frame (the pose, m), each divided by its scale in
-:class:`SearchSettings` and squared. A fallen state, or one where MuJoCo met a diverging
-acceleration (:meth:`Tracker.unstable`), costs infinity.
+:class:`SearchSettings` and squared. A fallen or lost state (``sim.tracking``'s criteria), or
+one where MuJoCo met a diverging acceleration (:meth:`Tracker.unstable`), costs infinity.
 """
 
 from __future__ import annotations
@@ -124,9 +124,12 @@ def state_cost(
     capture = np.linalg.norm(tracker._capture_error(q_ref, com))
     tilt = np.degrees(np.arccos(np.clip(_up(d.qpos[None])[0] @ _up(q_ref[None])[0], -1, 1)))
     head = abs(d.site_xpos[tracker.sites[HEAD], 2] - sites[HEAD, 2])
+    lost = np.linalg.norm(d.site_xpos[tracker.sites] - sites, axis=1).mean()
+    fall = tracker.settings
     if (
-        tilt > tracker.settings.fall_tilt_deg
-        or head > (1 - tracker.settings.fall_head_ratio) * (sites[HEAD, 2])
+        tilt > fall.fall_tilt_deg
+        or head > (1 - fall.fall_head_ratio) * sites[HEAD, 2]
+        or lost > fall.lost_error_m
     ):
         return np.inf
     root = tracker.sites[BODY17.index("pelvis")]

@@ -54,7 +54,10 @@ targets for walks of 10 s and more.
 A fall (after Peng et al. 2018, DeepMimic, whose episodes end when the character falls) is
 the first frame where the head is below :attr:`TrackingSettings.fall_head_ratio` of the
 reference head height, or the root's up axis is tilted more than
-:attr:`TrackingSettings.fall_tilt_deg` away from the reference root's.
+:attr:`TrackingSettings.fall_tilt_deg` away from the reference root's. A body that stays up
+but loses the reference, its body17 sites on average more than
+:attr:`TrackingSettings.lost_error_m` from the reference's (the 0.5 m termination distance of
+Luo et al. 2023, "Perpetual humanoid control"), has failed as well and counts as fallen there.
 """
 
 from __future__ import annotations
@@ -109,6 +112,7 @@ class TrackingSettings:
         control_period: simulation steps per controller update (torques held in between).
         fall_head_ratio: fall when head height < this x the reference head height.
         fall_tilt_deg: fall when the root's up axis is this far from the reference's.
+        lost_error_m: fall (lost) when the mean body17 distance from the reference is larger.
     """
 
     kp: float = 400.0
@@ -139,6 +143,7 @@ class TrackingSettings:
     control_period: int = 5
     fall_head_ratio: float = 0.6
     fall_tilt_deg: float = 60.0
+    lost_error_m: float = 0.5
 
 
 @dataclass(frozen=True)
@@ -150,7 +155,7 @@ class TrackingResult:
         body17_error: ``(T, 17)`` distance (metres) of each body17 site from the reference.
         torque: ``(T, nu)`` actuator torques (N m) at each frame.
         power: ``(T,)`` mechanical power sum |tau * qd| over the hinges (W).
-        fall_frame: first frame judged fallen, or ``None``.
+        fall_frame: first frame judged fallen (or lost, module docstring), or ``None``.
         fps: reference frame rate.
         reference_frame: ``(T,)`` the (fractional) reference frame played at each frame
             (:attr:`TrackingSettings.clock_gain`); errors and falls are judged against it.
@@ -670,7 +675,8 @@ class Tracker:
         head = BODY17.index("head")
         low = sites[:, head, 2] < self.settings.fall_head_ratio * ref_sites[:, head, 2]
         tilt = np.degrees(np.arccos(np.clip(np.sum(_up(qpos) * _up(qpos_ref), -1), -1, 1)))
-        fallen = np.flatnonzero(low | (tilt > self.settings.fall_tilt_deg) | unstable)
+        lost = np.linalg.norm(sites - ref_sites, axis=-1).mean(axis=1) > self.settings.lost_error_m
+        fallen = np.flatnonzero(low | (tilt > self.settings.fall_tilt_deg) | unstable | lost)
         return int(fallen[0]) if fallen.size else None
 
 

@@ -121,3 +121,14 @@ def test_a_diverging_simulation_counts_as_a_fall(body):
     result = tracker.run(body.qpos_from_motion(walk), walk.fps)
     assert tracker.unstable()
     assert result.fall_frame == 1
+
+
+def test_a_body_left_behind_by_its_reference_is_lost(body):
+    """The reference stands, then jumps 1 m sideways: the humanoid stays up but is lost
+    (mean body17 distance over 0.5 m) from the jump on."""
+    model = humanoid_model(body)
+    jumped = np.tile(model.qpos0, (31, 1))
+    jumped[15:, 1] += 1.0
+    result = track(model, jumped, 30.0)
+    assert result.fall_frame == 15
+    assert result.body17_error[:15].mean() < 0.01
