@@ -22,9 +22,11 @@ skating are measured in the floor frame (floor at z = 0, Z up):
   ``float_window_s`` around it: a body that touches the floor at least once in that window
   does not float (flights longer than 0.5 s, jumps higher than g t^2 / 8 ~ 30 cm, count).
   PhysDiff's per-frame lowest point height is the special case of a zero window.
-- **skating**: horizontal speed of a foot's stillest contact point while in contact (cm/s).
-  The clip's value is the worst foot's median; a frame skates above ``skate_speed_cm_s``; a
-  stance (run of contact frames) slides by the distance its stillest point moved. The
+- **skating**: horizontal slip speed of a foot's contact (cm/s): the speed of the stillest
+  point of its sole between its points in contact, so rolling heel-to-toe and pivoting about a
+  point of the sole do not count. The clip's value is the worst foot's median; a frame skates
+  above ``skate_speed_cm_s``; a stance (run of contact frames) slides by its slip velocity
+  summed over the stance (how far the contact moved on the floor). The
   humanoid's foot is one rigid box without a toe joint, so the sole's points move during
   push-off even in clean mocap (CMU running: stance median 18-25 cm/s); the median threshold
   (40 cm/s) leaves room for that, the slide threshold (10 cm per stance) catches slow drift.

@@ -14,7 +14,7 @@ from avatar_models.motion import Motion
 from sim.checks.joint_limits import JointLimits
 from sim.checks.replay import BodyReplay
 from sim.checks.residual import cone_distance
-from sim.checks.skating import contact_runs
+from sim.checks.skating import contact_runs, slip_velocity
 from sim.plausibility import check_motion
 from sim.thresholds import CheckConfig, ConfigError
 
@@ -67,6 +67,64 @@ def test_cone_distance_analytic():
 def test_contact_runs():
     runs = contact_runs(np.array([0, 1, 1, 0, 1, 0, 1, 1, 1], dtype=bool))
     np.testing.assert_array_equal(runs, [[1, 2], [4, 4], [6, 8]])
+
+
+def test_slip_velocity_of_a_rigid_sole_is_zero_at_its_pivot():
+    """Heel (0, 0) and toe (0.25, 0) turning about (0.1, 0): the pivot between them does not
+    slip; translated, every point slips; turning about a point behind the heel, the heel
+    (the stillest point of the sole) slips."""
+    omega = 2.0
+    pts = np.array([[0.0, 0.0], [0.25, 0.0]])
+    turn = omega * np.stack([-(pts[:, 1] - 0.0), pts[:, 0] - 0.1], axis=-1)  # w x (p - c)
+    both = np.ones(2, dtype=bool)
+    np.testing.assert_allclose(slip_velocity(turn, both), [0.0, 0.0], atol=1e-12)
+    np.testing.assert_allclose(slip_velocity(np.tile([0.0, 0.3], (2, 1)), both), [0.0, 0.3])
+    np.testing.assert_allclose(slip_velocity(turn + [0.0, 0.3], both), [0.0, 0.1], atol=1e-12)
+    # the heel alone in contact slips at its own velocity; no contact: NaN
+    np.testing.assert_allclose(slip_velocity(turn, np.array([True, False])), turn[0])
+    assert np.all(np.isnan(slip_velocity(turn, np.zeros(2, dtype=bool))))
+
+
+def pivot_on_left_sole(body, yaw_deg: float, slide_m: float = 0.0, frames: int = 90) -> Motion:
+    """Standing on the left foot (right knee bent, that foot in the air), the whole body turns
+    ``yaw_deg`` about a vertical axis through the middle of the left sole (between its heel
+    and ball, on none of the sole points the checks sample), and drifts ``slide_m`` along +Y."""
+    m = still_pose(body, 0.0, frames)
+    knee = body.anatomy.body17["r_knee"]
+    order = body.hinge_order(knee)
+    ranges = body.hinge_ranges[knee]
+    axis = max(ranges, key=lambda a: ranges[a][1] - ranges[a][0])
+    angles = np.zeros((frames, 3))
+    angles[:, order.lower().index(axis)] = 0.8 * ranges[axis][1]
+    local = m.local_rot.copy()
+    local[:, knee] = quat.from_scipy(Rotation.from_euler(order, angles))
+    m = m.replace(local_rot=local)
+    model = mujoco.MjModel.from_xml_string(body.to_mjcf())
+    replay = BodyReplay.run(body, model, body.qpos_from_motion(m[:1]), m.fps, CheckConfig())
+    heel, ball = replay.sole_points[0, 0, 0], replay.sole_points[0, 0, 1]
+    centre = np.array([*(0.5 * (heel + ball))[:2], 0.0])
+    s = np.linspace(0.0, 1.0, frames)
+    ramp = s * s * (3.0 - 2.0 * s)  # starts and stops at rest
+    turn = Rotation.from_euler("z", np.radians(yaw_deg) * ramp[:, None])
+    root = centre + turn.apply(m.root_pos - centre)
+    root[:, 1] += slide_m * ramp
+    local[:, 0] = quat.mul(quat.from_scipy(turn), local[:, 0])
+    return m.replace(root_pos=root, local_rot=local)
+
+
+def test_pivot_about_the_sole_is_no_skating_but_sliding_is(rest_body):
+    """A basketball pivot: the planted foot turns 60 degrees about a point of its sole. The
+    heel and toe travel ~10 cm each, the foot's contact does not move: not skating. A drift
+    of 20 cm is skating, with the pivot too (part of it is then a turn about a point further
+    back on the sole)."""
+    pivot = check_motion(pivot_on_left_sole(rest_body, 60.0), rest_body)
+    assert pivot.values["contact_frac"] == 1.0
+    assert pivot.values["skate_slide_cm_max"] < 1.0, pivot.values
+    assert pivot.values["skate_cm_s_median"] < 1.0 and not pivot.flagged("skating")
+    sliding = check_motion(pivot_on_left_sole(rest_body, 0.0, slide_m=0.20), rest_body)
+    np.testing.assert_allclose(sliding.values["skate_slide_cm_max"], 20.0, atol=0.5)
+    both = check_motion(pivot_on_left_sole(rest_body, 60.0, slide_m=0.20), rest_body)
+    assert sliding.flagged("skating") and both.flagged("skating")
 
 
 def test_config_from_dict_and_toml(tmp_path):
