@@ -3,11 +3,12 @@ retargeting frames/s.
 
 Rows: simulated seconds per wall second tracking the built-in walk with the plain controller
 (``sim.tracking``: a whole-body QP every 5 simulation steps, 100 Hz; aim at least 10x real
-time) and with the sampling search (``sim.sampling``, 48 simulations of every window), next to
-real time (1x); the share of 10 s built-in walks (seeds 0-3) tracked without a fall by the
-search, next to the plain controller's share (not in ``--quick``); retargeting frames/s
-(``sim.retarget``: body17 IK with mink) on a CMU clip from ``../shared/mocap`` (the built-in
-walk when that folder is absent), next to the clip's own frame rate.
+time) and with the sampling search (``sim.sampling``: 48 samples of every 0.2 s window, each
+judged 0.2 s later), next to real time (1x); the share of 10 s built-in walks (seeds 0-3)
+tracked without a fall by the search, next to the plain controller's share (not in
+``--quick``); retargeting frames/s (``sim.retarget``: body17 IK with mink) on a CMU clip from
+``../shared/mocap`` (the built-in walk when that folder is absent), next to the clip's own
+frame rate.
 """
 
 from __future__ import annotations
