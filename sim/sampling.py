@@ -26,12 +26,15 @@ one where MuJoCo met a diverging acceleration (:meth:`Tracker.unstable`), costs 
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 from tqdm import tqdm
 
+from avatar_models.body import BodyDescription
+from avatar_models.body.ik import humanoid_model
 from avatar_models.body17 import BODY17
 from sim.soles import subtree_mask
 from sim.tracking import (
@@ -42,6 +45,7 @@ from sim.tracking import (
     TrackingResult,
     TrackingSettings,
     _up,
+    track,
 )
 
 HEAD = BODY17.index("head")
@@ -118,29 +122,22 @@ def state_cost(
     """Cost of the tracker's current state against the reference at ``progress.clock``
     (module docstring); infinity once fallen."""
     d = tracker.data
-    if tracker.unstable():
-        return np.inf
     clock = min(progress.clock, ref.qpos.shape[0] - 1.0)
     i = min(int(clock), ref.qpos.shape[0] - 2)
     a = clock - i
     com = (1 - a) * ref.com[i] + a * ref.com[i + 1]
     sites = (1 - a) * ref.sites[i] + a * ref.sites[i + 1]
     q_ref = ref.qpos[int(round(clock))]
+    now = d.site_xpos[tracker.sites]
+    if tracker.fallen(d.qpos[None], q_ref[None], now[None], sites[None], tracker.unstable())[0]:
+        return np.inf
     tracker._com_jacobian()
     capture = np.linalg.norm(tracker._capture_error(q_ref, com))
     tilt = np.degrees(np.arccos(np.clip(_up(d.qpos[None])[0] @ _up(q_ref[None])[0], -1, 1)))
-    head = abs(d.site_xpos[tracker.sites[HEAD], 2] - sites[HEAD, 2])
-    lost = np.linalg.norm(d.site_xpos[tracker.sites] - sites, axis=1).mean()
-    fall = tracker.settings
-    if (
-        tilt > fall.fall_tilt_deg
-        or head > (1 - fall.fall_head_ratio) * sites[HEAD, 2]
-        or lost > fall.lost_error_m
-    ):
-        return np.inf
+    head = abs(now[HEAD, 2] - sites[HEAD, 2])
     root = tracker.sites[BODY17.index("pelvis")]
     pose = np.linalg.norm(
-        (d.site_xpos[tracker.sites] - d.site_xpos[root]) - (sites - sites[BODY17.index("pelvis")]),
+        (now - d.site_xpos[root]) - (sites - sites[BODY17.index("pelvis")]),
         axis=1,
     ).mean()
     # Roll and pitch rates of the root (its local x, y), which the capture point (linear
@@ -257,3 +254,32 @@ def replay(
     for offset in offsets:
         progress = tracker.advance(ref, progress, window_steps, offset)
     return tracker.result(ref, progress.frames)
+
+
+def timed_tracking(
+    body: BodyDescription,
+    qpos_ref: np.ndarray,
+    fps: float,
+    search: SearchSettings | None,
+    progress_bar: bool = False,
+) -> tuple[TrackingResult, dict]:
+    """Track ``qpos_ref (T, nq)`` on a fresh humanoid of ``body``: by :func:`search_track`
+    with ``search``, or by the plain controller when it is ``None``. Returns the result and
+    its summary (:meth:`TrackingResult.summary`) with the mode, the search's settings and
+    simulated seconds, the wall time and the speed next to real time."""
+    model = humanoid_model(body)
+    start = time.perf_counter()
+    if search is None:
+        result, extra = track(model, qpos_ref, fps), {"mode": "plain"}
+    else:
+        searched = search_track(model, qpos_ref, fps, search=search, progress_bar=progress_bar)
+        result = searched.result
+        extra = {
+            "mode": "search",
+            "samples": search.samples,
+            "beam": search.beam,
+            "simulated_s": searched.simulated_s,
+        }
+    wall = time.perf_counter() - start
+    summary = result.summary() | extra | {"wall_s": wall}
+    return result, summary | {"x_real_time": summary["duration_s"] / wall}

@@ -671,12 +671,18 @@ class Tracker:
             mujoco.mju_quat2Vel(err, err_quat, 1.0)
             yield jr.copy(), s.kp_foot * err + s.kd_foot * (jr_ref @ v_target - jr @ d.qvel)
 
-    def _fall_frame(self, qpos, qpos_ref, sites, ref_sites, unstable) -> int | None:
-        head = BODY17.index("head")
-        low = sites[:, head, 2] < self.settings.fall_head_ratio * ref_sites[:, head, 2]
+    def fallen(self, qpos, qpos_ref, sites, ref_sites, unstable) -> np.ndarray:
+        """``(T,)`` whether each frame is fallen or lost (module docstring): ``qpos`` and
+        ``qpos_ref (T, nq)``, body17 ``sites`` and ``ref_sites (T, 17, 3)``, ``unstable (T,)``
+        (:meth:`unstable`)."""
+        s, head = self.settings, BODY17.index("head")
+        low = sites[:, head, 2] < s.fall_head_ratio * ref_sites[:, head, 2]
         tilt = np.degrees(np.arccos(np.clip(np.sum(_up(qpos) * _up(qpos_ref), -1), -1, 1)))
-        lost = np.linalg.norm(sites - ref_sites, axis=-1).mean(axis=1) > self.settings.lost_error_m
-        fallen = np.flatnonzero(low | (tilt > self.settings.fall_tilt_deg) | unstable | lost)
+        lost = np.linalg.norm(sites - ref_sites, axis=-1).mean(axis=1) > s.lost_error_m
+        return low | (tilt > s.fall_tilt_deg) | unstable | lost
+
+    def _fall_frame(self, qpos, qpos_ref, sites, ref_sites, unstable) -> int | None:
+        fallen = np.flatnonzero(self.fallen(qpos, qpos_ref, sites, ref_sites, unstable))
         return int(fallen[0]) if fallen.size else None
 
 

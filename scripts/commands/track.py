@@ -11,7 +11,6 @@ viewer into ``--export``. Exit 1 when the humanoid falls, 2 for bad input.
 
 from __future__ import annotations
 
-import time
 from pathlib import Path
 from typing import Annotated
 
@@ -49,13 +48,11 @@ def register(app: typer.Typer) -> None:
         json_out: JsonOpt = None,
     ) -> None:
         """Physics tracking of a motion by the MuJoCo humanoid. Exit 1 if it falls."""
-        from avatar_models.body.ik import humanoid_model
         from avatar_models.errors import MotionValueError
         from scripts.results import atomic_dir
         from sim.plausibility import body_and_motion
-        from sim.sampling import SearchSettings, search_track
+        from sim.sampling import SearchSettings, timed_tracking
         from sim.tracking import looped
-        from sim.tracking import track as plain_track
         from sim.tracking_report import write_outputs
 
         if seconds is not None and not seconds > 0:
@@ -70,25 +67,10 @@ def register(app: typer.Typer) -> None:
         summary_extra = {"motion": motion, "seed": seed, "fps": m.fps}
         if "retarget_residual_cm" in m.meta:
             summary_extra["retarget_residual_cm"] = m.meta["retarget_residual_cm"]
-        start = time.perf_counter()
-        if plain:
-            result = plain_track(humanoid_model(body), qpos, m.fps)
-            summary_extra |= {"mode": "plain"}
-        else:
-            search = SearchSettings(samples=samples, beam=beam, seed=seed)
-            searched = search_track(
-                humanoid_model(body), qpos, m.fps, search=search, progress_bar=True
-            )
-            result = searched.result
-            summary_extra |= {
-                "mode": "search",
-                "samples": samples,
-                "beam": beam,
-                "simulated_s": searched.simulated_s,
-            }
-        wall = time.perf_counter() - start
-        summary = result.summary() | summary_extra
-        summary |= {"wall_s": wall, "x_real_time": summary["duration_s"] / wall}
+        search = None if plain else SearchSettings(samples=samples, beam=beam, seed=seed)
+        result, summary = timed_tracking(body, qpos, m.fps, search, progress_bar=True)
+        summary |= summary_extra
+        wall = summary["wall_s"]
         table = Table(title=f"physics tracking ({summary['mode']}): {motion}")
         for col in ("quantity", "value"):
             table.add_column(col)

@@ -5,13 +5,10 @@ shorter). Writes ``tracking/`` (CSV, JSON, plot)."""
 
 from __future__ import annotations
 
-import time
-
-from avatar_models.body.ik import humanoid_model
 from scripts.run_context import RunContext
 from scripts.scenario import Scenario
-from sim.sampling import search_track
-from sim.tracking import looped, track
+from sim.sampling import SearchSettings, timed_tracking
+from sim.tracking import looped
 from sim.tracking_report import write_outputs
 
 METRICS = {
@@ -32,19 +29,14 @@ def run(ctx: RunContext) -> None:
         return
     fps = ctx.motion.fps
     qpos = looped(ctx.qpos, fps, spec.seconds)
-    start = time.perf_counter()
-    if spec.search:
-        result = search_track(humanoid_model(ctx.body), qpos, fps).result
-    else:
-        result = track(humanoid_model(ctx.body), qpos, fps)
-    wall = time.perf_counter() - start
-    summary = result.summary() | {"mode": "search" if spec.search else "plain", "wall_s": wall}
+    search = SearchSettings() if spec.search else None
+    result, summary = timed_tracking(ctx.body, qpos, fps, search)
     upright = summary["duration_s"] if result.fall_time_s is None else result.fall_time_s
     ctx.metrics |= {
         "tracking_fell": float(result.fell),
         "tracking_upright_s": upright,
         "tracking_err_cm_mean": summary["body17_err_cm_mean"],
-        "tracking_x_real_time": summary["duration_s"] / wall,
+        "tracking_x_real_time": summary["x_real_time"],
     }
     ctx.info["tracking"] = summary
     title = f"physics tracking of the ground truth ({summary['mode']})"
