@@ -34,8 +34,8 @@ def _speed_rows(quick: bool) -> list[BenchRow]:
     walk = generate("walk", duration_s=seconds, fps=30.0)
     h = humanoid_for(walk)
     repeats = 1 if quick else 3
-    plain = best_of(lambda: track(h.model_copy(), h.qpos, walk.fps), repeats)
-    search = best_of(lambda: search_track(h.model_copy(), h.qpos, walk.fps), 1)
+    plain = best_of(lambda: track(h.model, h.qpos, walk.fps), repeats)
+    search = best_of(lambda: search_track(h.model, h.qpos, walk.fps), 1)
     note = f"{seconds:.0f} s walk"
     return [
         BenchRow("tracking[walk, plain]", "x real time", seconds / plain, 1.0, "real time", note),
@@ -49,8 +49,8 @@ def _upright_row() -> BenchRow:
     for seed in seeds:
         walk = generate("walk", duration_s=seconds, fps=30.0, seed=seed)
         h = humanoid_for(walk)
-        upright["plain"] += not track(h.model_copy(), h.qpos, walk.fps).fell
-        upright["search"] += not search_track(h.model_copy(), h.qpos, walk.fps).result.fell
+        upright["plain"] += not track(h.model, h.qpos, walk.fps).fell
+        upright["search"] += not search_track(h.model, h.qpos, walk.fps).result.fell
     n = len(seeds)
     return BenchRow(
         "upright[walk 10 s, search]",
