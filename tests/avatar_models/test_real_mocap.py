@@ -20,6 +20,7 @@ from avatar_models.formats.bvh import read_bvh, write_bvh
 from avatar_models.formats.units import Y_UP_TO_Z_UP
 from avatar_models.measure import bone_lengths_over_time, lowest_point, standing_height
 from avatar_models.rigs import body17_positions, identify_rig
+from tests.conftest import require_module
 
 pytestmark = pytest.mark.mocap
 
@@ -86,7 +87,7 @@ def test_clips_walk_forward_with_left_on_the_left(clips):
 
 
 def _bvhio_positions(path: Path, frames: list[int]) -> dict[str, np.ndarray]:
-    bvhio = pytest.importorskip("bvhio")
+    bvhio = require_module("bvhio")
     root = bvhio.readAsHierarchy(str(path))
     out: dict[str, list] = {}
     for frame in frames:
