@@ -52,8 +52,8 @@ SOURCE_FACTS = {"cmu": ("cmu", 120.0), "bandai": ("cm", 30.0)}
 
 def test_every_clip_loads_with_its_rig(clips):
     """Every clip, not one per source: its rig, unit and frame rate are those the shared
-    README gives for its source, its arrays are finite, it has frames to speak of. (Heights and bone lengths of every clip
-    are checked below.)"""
+    README gives for its source, its arrays are finite, it has frames to speak of. (Heights
+    and bone lengths of every clip are checked below.)"""
     failures = {k: repr(v) for k, v in clips.items() if isinstance(v, Exception)}
     assert len(clips) >= 390 and not failures
     per_source = {s: [k for k in clips if k.split("/")[0] == s] for s in SOURCE_FACTS}
