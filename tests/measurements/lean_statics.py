@@ -13,7 +13,7 @@ from avatar_models.body import build_body
 from avatar_models.body.ik import humanoid_model
 from avatar_models.generator import generate, sample_subject
 from avatar_models.rigs import load_rig
-from sim.soles import FEET
+from sim.soles import foot_bodies
 from sim.tracking import track
 from tests.sim.test_tracking import _leaning
 
@@ -23,7 +23,7 @@ def ankle_balance(body, degrees: float = 4.0) -> list[tuple[float, float]]:
     model = humanoid_model(body)
     result = track(model, body.qpos_from_motion(_leaning(body, degrees)), 30.0)
     data = mujoco.MjData(model)
-    feet = [model.body(name).id for name in FEET]
+    feet = [model.body(name).id for name in foot_bodies(model)]
     at_ankle = [k for k, j in enumerate(model.actuator_trnid[:, 0]) if model.jnt_bodyid[j] in feet]
     mass, foot_mass = model.body_subtreemass[0], model.body_subtreemass[feet]
     out = []

@@ -15,7 +15,7 @@ from avatar_models.errors import MotionValueError
 from avatar_models.generator import generate, sample_subject
 from avatar_models.motion import Motion
 from avatar_models.rigs import load_rig
-from sim.soles import FEET
+from sim.soles import foot_bodies
 from sim.tracking import Tracker, TrackingSettings, looped, track
 
 BANDAI_WALK = "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh"
@@ -69,6 +69,7 @@ def _newton_residual_bw(body, seconds: float, push_bw: float = 0.0, seed: int = 
     model = humanoid_model(body)
     walk = generate("walk", duration_s=seconds, fps=30.0, seed=seed)
     tracker = Tracker(model)
+    model = tracker.model  # the tracker's own copy: motors, floor-only contacts
     ref = tracker.reference(body.qpos_from_motion(walk), walk.fps)
     progress = tracker.start(ref)
     data, probe = tracker.data, mujoco.MjData(model)
@@ -135,10 +136,11 @@ def _leaning(body, degrees: float, frames: int = 61) -> Motion:
     rot[..., 0] = 1.0
     root_rest = np.array([0.0, 0.0, body.root_height])
     rest = Motion(sk, 30.0, np.tile(root_rest, (frames, 1)), rot.copy())
-    foot_rest = rest.global_positions()[0, sk.index(FEET[0])]
+    feet = foot_bodies(humanoid_model(body))
+    foot_rest = rest.global_positions()[0, sk.index(feet[0])]
     lean = Rotation.from_euler("y", degrees, degrees=True)
     rot[:, 0] = quat.from_scipy(lean)
-    for foot in FEET:
+    for foot in feet:
         rot[:, sk.index(foot)] = quat.from_scipy(lean.inv())
     root = foot_rest - lean.apply(foot_rest - root_rest)
     return Motion(sk, 30.0, np.tile(root, (frames, 1)), rot)
@@ -166,7 +168,7 @@ def test_ankle_torques_are_what_statics_demands_leaning_forward(subject):
     result = track(model, lean_body.qpos_from_motion(_leaning(lean_body, 4.0)), 30.0)
     assert not result.fell and result.body17_error[-1].mean() < 0.01
     data = mujoco.MjData(model)
-    feet = [model.body(name).id for name in FEET]
+    feet = [model.body(name).id for name in foot_bodies(model)]
     at_ankle = [k for k, j in enumerate(model.actuator_trnid[:, 0]) if model.jnt_bodyid[j] in feet]
     mass, foot_mass = model.body_subtreemass[0], model.body_subtreemass[feet]
     for t in (40, 50, 60):
