@@ -30,13 +30,14 @@ import numpy as np
 from scipy.signal import lfilter
 
 from avatar_models import Motion, quat
-from avatar_models.body import build_body
+from avatar_models.body import BodyDescription
 from avatar_models.body17 import INDEX
 from avatar_models.rigs import Rig, identify_rig, load_rig
 from render_cams.device import motion_at_rate, resolve_seed
 from render_cams.kinect.capsules import posed_capsules
 from render_cams.kinect.placement import check_sensor_pose, default_sensor_pose
 from render_cams.kinect.sensors import DepthSensor, KinectError, get_sensor
+from render_cams.scene import body_for_motion
 
 
 class TrackingState(IntEnum):
@@ -175,24 +176,36 @@ def kinect_skeleton(
     sensor_pose: np.ndarray | None = None,
     seed: int | np.random.Generator = 0,
     noise: SkeletonNoise | None | str = "default",
+    body: BodyDescription | None = None,
 ) -> KinectSkeletonStream:
     """The skeleton stream a Kinect at ``sensor_pose`` reports for ``motion`` at 30 Hz.
 
     Args:
         motion: any motion whose rig has a body17 map.
         device: a sensor name of :data:`~render_cams.kinect.sensors.SENSORS` or a sensor.
-        sensor_pose: ``(4, 4)`` camera-to-world; default :func:`default_sensor_pose`.
+        sensor_pose: ``(4, 4)`` camera-to-world; default :func:`default_sensor_pose` (set up
+            for this take).
         seed: randomness for the noise; recorded in ``meta``.
         noise: ``"default"`` (per-rig :data:`NOISE_BY_RIG`), a :class:`SkeletonNoise`, or
             ``None`` for exact joints.
+        body: the humanoid built once for ``motion`` (``motion`` on its skeleton), for the
+            occlusion tests; default: a body built from ``motion``'s skeleton.
+
+    Joints outside the sensor's range or field of view are NotTracked in that frame (their
+    positions are what the tracker would not report: the ground truth, without noise).
 
     Raises:
-        UnknownDeviceError, KinectPlacementError (sensor inside the body), KinectError.
+        UnknownDeviceError, KinectPlacementError (sensor below the floor or inside the body
+        for the whole take), KinectError, SceneError (motion not on ``body``'s skeleton).
     """
     sensor = get_sensor(device)
     sampled = motion_at_rate(motion, sensor.rate_hz)
-    pose = default_sensor_pose(sampled) if sensor_pose is None else np.asarray(sensor_pose, float)
-    body = build_body(sampled.skeleton)
+    body = body_for_motion(sampled, body)
+    pose = (
+        default_sensor_pose(sampled, sensor)
+        if sensor_pose is None
+        else np.asarray(sensor_pose, float)
+    )
     check_sensor_pose(pose, body, sampled)
     rig = load_rig(sensor.rig)
     positions, orientations = rig_joints(sampled, rig)
