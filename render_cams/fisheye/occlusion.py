@@ -12,9 +12,10 @@ frames, §4.2) has to recognise them. Two cases, decided from the geometry of ea
   surface can be measured), no keypoint visible. ``lens_blocked`` is 1.
 - **Lens against the body**: surfaces closer than :data:`BLOCKING_RANGE_M` to the camera
   centre are in the shadow of the controller and the hand holding it (and far inside the
-  near focus limit of a small fixed-focus lens): their pixels are darkened in proportion,
-  ``colour * range / BLOCKING_RANGE_M``. ``lens_blocked`` is the fraction of the image circle
-  they cover.
+  near focus limit of a small fixed-focus lens): their pixels are darkened,
+  ``colour * (range / BLOCKING_RANGE_M) ** 2`` (the share of the room's light the controller
+  leaves them falls like the solid angle it covers). ``lens_blocked`` is the fraction of the
+  image circle they cover.
 
 A frame is ``occluded`` when ``lens_blocked >= OCCLUDED_FRACTION``: at least half the image
 circle shows nothing but the body at touching distance (or nothing at all). The record also
@@ -62,7 +63,7 @@ def block_lens(
     near = image_circle & (range_m > 0) & (range_m < BLOCKING_RANGE_M)
     if not near.any():
         return colour, 0.0
-    shade = np.where(near, range_m / BLOCKING_RANGE_M, 1.0)[..., None]
+    shade = np.where(near, (range_m / BLOCKING_RANGE_M) ** 2, 1.0)[..., None]
     darkened = np.rint(colour * shade).astype(np.uint8)
     return darkened, float(near.sum() / max(int(image_circle.sum()), 1))
 

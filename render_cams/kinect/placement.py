@@ -87,7 +87,7 @@ def mean_facing(motion: Motion) -> np.ndarray:
     A take that turns full circles has no mean: the first frame's facing is used then."""
     b17 = body17_positions(motion)
     left = b17[:, INDEX["l_hip"], :2] - b17[:, INDEX["r_hip"], :2]
-    facing = np.stack([-left[:, 1], left[:, 0]], axis=1)  # (l_x, l_y, 0) x (0, 0, 1)
+    facing = np.stack([left[:, 1], -left[:, 0]], axis=1)  # (l_x, l_y, 0) x (0, 0, 1)
     facing /= np.maximum(np.linalg.norm(facing, axis=1, keepdims=True), 1e-12)
     mean = facing.mean(axis=0)
     if np.linalg.norm(mean) < 0.2:  # spins round: no prevailing direction
@@ -152,18 +152,17 @@ def default_sensor_pose(
     centre = np.asarray(centre)
     along = (b17[..., :2] - centre) @ facing  # (T, 17) how far ahead of the centre
     near, far = sensor.range_m
-    distances = np.arange(near + max(along.max(), 0.0), far + max(-along.min(), 0.0), DISTANCE_STEP_M)
+    distances = np.arange(
+        near + max(along.max(), 0.0), far + max(-along.min(), 0.0), DISTANCE_STEP_M
+    )
     if distances.size == 0:
         distances = np.array([near + max(along.max(), 0.0)])
     poses = np.stack(
-        [
-            look_at([*(centre + d * facing), height_m], [*centre, target_z])
-            for d in distances
-        ]
+        [look_at([*(centre + d * facing), height_m], [*centre, target_z]) for d in distances]
     )  # (D, 4, 4)
-    seen = in_view(
-        b17[None], poses[:, None, None], sensor, RANGE_MARGIN_M, IMAGE_MARGIN
-    ).mean(axis=(1, 2))  # (D,)
+    seen = in_view(b17[None], poses[:, None, None], sensor, RANGE_MARGIN_M, IMAGE_MARGIN).mean(
+        axis=(1, 2)
+    )  # (D,)
     best = int(np.flatnonzero(seen >= seen.max() - 1e-9)[0])
     return poses[best]
 

@@ -121,7 +121,8 @@ class KinectSkeletonStream:
         rig: ``"kinect_v2"`` or ``"azure_kinect"``.
         joint_names: ``J`` names in the rig's order.
         timestamps: ``(T,)`` seconds.
-        positions: ``(T, J, 3)`` world metres (Z up), noise included.
+        positions: ``(T, J, 3)`` world metres (Z up), noise included; meaningless where
+            ``states`` is NotTracked (the JSON frames leave those out).
         orientations: ``(T, J, 4)`` world wxyz relative to the rig's T-pose.
         states: ``(T, J)`` int8 :class:`TrackingState`.
         sensor_pose: ``(4, 4)`` camera-to-world pose (OpenCV axes).
@@ -149,18 +150,30 @@ class KinectSkeletonStream:
         return opencv * np.array([-1.0, -1.0, 1.0])
 
     def frame_dict(self, t: int) -> dict[str, Any]:
-        """Frame ``t`` as a JSON-ready dict (positions in world and camera space)."""
+        """Frame ``t`` as a JSON-ready dict (positions in world and camera space).
+
+        As the SDKs report it: a NotTracked joint has no position (``null``), and a frame in
+        which no joint is tracked (the performer out of range or view) has no body
+        (``body_tracked: false``)."""
         cam = self.camera_space()[t]
+        states = self.states[t]
+
+        def where(values: np.ndarray, state: int) -> list[float] | None:
+            return None if state == TrackingState.NOT_TRACKED else np.round(values, 5).tolist()
+
         return {
             "timestamp_s": float(self.timestamps[t]),
             "rig": self.rig,
+            "body_tracked": bool(np.any(states != TrackingState.NOT_TRACKED)),
             "joints": [
                 {
                     "name": name,
-                    "position_world_m": np.round(self.positions[t, j], 5).tolist(),
-                    "position_camera_m": np.round(cam[j], 5).tolist(),
-                    "orientation_wxyz": np.round(self.orientations[t, j], 6).tolist(),
-                    "tracking_state": TrackingState(int(self.states[t, j])).name,
+                    "position_world_m": where(self.positions[t, j], states[j]),
+                    "position_camera_m": where(cam[j], states[j]),
+                    "orientation_wxyz": None
+                    if states[j] == TrackingState.NOT_TRACKED
+                    else np.round(self.orientations[t, j], 6).tolist(),
+                    "tracking_state": TrackingState(int(states[j])).name,
                 }
                 for j, name in enumerate(self.joint_names)
             ],
@@ -191,8 +204,8 @@ def kinect_skeleton(
         body: the humanoid built once for ``motion`` (``motion`` on its skeleton), for the
             occlusion tests; default: a body built from ``motion``'s skeleton.
 
-    Joints outside the sensor's range or field of view are NotTracked in that frame (their
-    positions are what the tracker would not report: the ground truth, without noise).
+    Joints outside the sensor's range or field of view are NotTracked in that frame: no noise
+    is added to them and the JSON frames report no position for them.
 
     Raises:
         UnknownDeviceError, KinectPlacementError (sensor below the floor or inside the body

@@ -22,8 +22,21 @@ from scripts.cli_common import JsonOpt, SeedOpt, console, emit_json, load_motion
 
 DEVICES = ("fisheye", "kinect-v2", "azure-kinect", "azure-kinect-wfov-binned")
 DEFAULT_DURATION_S = 2.0
-FISHEYE_OPTIONS = ("--fov", "--size", "--ring-offset", "--grip-offset", "--ring-pitch", "--grip-pitch")
-KINECT_OPTIONS = ("--sensor-pos", "--sensor-yaw", "--sensor-pitch", "--sensor-look-at", "--sensor-height")
+FISHEYE_OPTIONS = (
+    "--fov",
+    "--size",
+    "--ring-offset",
+    "--grip-offset",
+    "--ring-pitch",
+    "--grip-pitch",
+)
+KINECT_OPTIONS = (
+    "--sensor-pos",
+    "--sensor-yaw",
+    "--sensor-pitch",
+    "--sensor-look-at",
+    "--sensor-height",
+)
 
 
 def _numbers(text: str | None, option: str, n: int, kind=float) -> tuple | None:
