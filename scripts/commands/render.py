@@ -81,31 +81,41 @@ def _check_device_options(device: str, given: dict[str, object]) -> None:
         raise AvatarsimError("give --sensor-look-at or --sensor-yaw/--sensor-pitch, not both")
 
 
-def _frame_range(
-    start_s: float, end: str | None, duration_s: float | None, clip_s: float
-) -> tuple[float, float]:
-    """The ``(start, end)`` seconds to render of a clip of ``clip_s`` seconds."""
+def _parse_range(start_s: float, end: str | None) -> float | str | None:
+    """``--end`` as seconds after a valid ``--start``, ``"end"``, or None (checked before any
+    motion is loaded)."""
     from avatar_models.errors import AvatarsimError
 
     if not (math.isfinite(start_s) and start_s >= 0):
         raise AvatarsimError(f"--start must be a non-negative number of seconds, got {start_s}")
-    if start_s >= clip_s:
-        raise AvatarsimError(f"--start {start_s:g} s is past the clip's end ({clip_s:.3f} s)")
-    if end is None:
-        return start_s, min(start_s + (duration_s or DEFAULT_DURATION_S), clip_s)
-    if end == "end":
-        return start_s, clip_s
+    if end is None or end == "end":
+        return end
     try:
         end_s = float(end)
     except ValueError:
         raise AvatarsimError(f"--end takes seconds or 'end', got {end!r}") from None
     if not (math.isfinite(end_s) and end_s > start_s):
         raise AvatarsimError(f"--end must be after --start ({start_s:g} s), got {end!r}")
-    if end_s > clip_s + 1e-6:
+    return end_s
+
+
+def _frame_range(
+    start_s: float, end: float | str | None, duration_s: float | None, clip_s: float
+) -> tuple[float, float]:
+    """The ``(start, end)`` seconds to render of a clip of ``clip_s`` seconds."""
+    from avatar_models.errors import AvatarsimError
+
+    if start_s >= clip_s:
+        raise AvatarsimError(f"--start {start_s:g} s is past the clip's end ({clip_s:.3f} s)")
+    if end is None:
+        return start_s, min(start_s + (duration_s or DEFAULT_DURATION_S), clip_s)
+    if end == "end":
+        return start_s, clip_s
+    if end > clip_s + 1e-6:
         raise AvatarsimError(
-            f"--end {end_s:g} s is past the clip's end ({clip_s:.3f} s); use --end end"
+            f"--end {end:g} s is past the clip's end ({clip_s:.3f} s); use --end end"
         )
-    return start_s, end_s
+    return start_s, float(end)
 
 
 def register(app: typer.Typer) -> None:
@@ -210,14 +220,12 @@ def register(app: typer.Typer) -> None:
         grip_xyz = _numbers(grip_offset, "--grip-offset", 3)
         pos_xyz = _numbers(sensor_pos, "--sensor-pos", 3)
         look_xyz = _numbers(sensor_look_at, "--sensor-look-at", 3)
+        end_at = _parse_range(start, end)
         # A built-in motion is generated long enough for the range asked.
-        try:
-            wanted_s = float(end) if end not in (None, "end") else None
-        except ValueError:
-            wanted_s = None
-        generate_s = wanted_s or start + (duration_s or DEFAULT_DURATION_S)
-        m = load_motion_arg(motion, unit, seed, generate_s if math.isfinite(generate_s) else 1.0)
-        start_s, end_s = _frame_range(start, end, duration_s, m.duration_s)
+        generate_s = end_at if isinstance(end_at, float) else None
+        generate_s = generate_s or start + (duration_s or DEFAULT_DURATION_S)
+        m = load_motion_arg(motion, unit, seed, generate_s)
+        start_s, end_s = _frame_range(start, end_at, duration_s, m.duration_s)
         first = int(round(start_s * m.fps))
         m = m[first : max(first + 2, int(round(end_s * m.fps)) + 1)]
 
