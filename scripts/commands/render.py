@@ -55,6 +55,15 @@ def _numbers(text: str | None, option: str, n: int, kind=float) -> tuple | None:
     return values
 
 
+def _rad(degrees: float) -> float:
+    """Degrees (CLI) to radians, refusing NaN and infinities."""
+    from avatar_models.errors import AvatarsimError
+
+    if not math.isfinite(degrees):
+        raise AvatarsimError(f"angles must be finite numbers of degrees, got {degrees}")
+    return math.radians(degrees)
+
+
 def _pair(text: str | None, option: str, default: tuple, kind=float) -> tuple:
     """``"A,B"`` -> ``(A, B)`` of ``kind``; a clear error for anything else."""
     return _numbers(text, option, 2, kind) or default
@@ -70,7 +79,11 @@ def _check_device_options(device: str, given: dict[str, object]) -> None:
         kind = "a Kinect device" if device == "fisheye" else "--device fisheye"
         raise AvatarsimError(f"{', '.join(wrong)} only apply to {kind}, not to --device {device}")
     if given.get("--sensor-pos") is None:
-        needs = [n for n in ("--sensor-yaw", "--sensor-pitch", "--sensor-look-at") if given.get(n)]
+        needs = [
+            n
+            for n in ("--sensor-yaw", "--sensor-pitch", "--sensor-look-at")
+            if given.get(n) is not None
+        ]
         if needs:
             raise AvatarsimError(f"{', '.join(needs)} need --sensor-pos (where the sensor stands)")
     elif given.get("--sensor-height") is not None:
@@ -214,13 +227,44 @@ def register(app: typer.Typer) -> None:
             raise AvatarsimError("give --end or --duration-s, not both")
         if duration_s is not None and not (math.isfinite(duration_s) and duration_s > 0):
             raise AvatarsimError(f"--duration-s must be positive, got {duration_s}")
-        fov_hv = _pair(fov, "--fov", (150, 120))
-        size_wh = _pair(size, "--size", (640, 480), int)
-        ring_xyz = _numbers(ring_offset, "--ring-offset", 3)
-        grip_xyz = _numbers(grip_offset, "--grip-offset", 3)
-        pos_xyz = _numbers(sensor_pos, "--sensor-pos", 3)
-        look_xyz = _numbers(sensor_look_at, "--sensor-look-at", 3)
         end_at = _parse_range(start, end)
+        # Every device option is checked before the motion is loaded and retargeted.
+        if device == "fisheye":
+            from render_cams.fisheye.model import FisheyeModel
+            from render_cams.fisheye.rig import Mount
+
+            model = FisheyeModel.from_fov(
+                *_pair(fov, "--fov", (150, 120)), *_pair(size, "--size", (640, 480), int)
+            )
+            default = Mount()
+            mount = Mount(
+                ring_offset_m=_numbers(ring_offset, "--ring-offset", 3) or default.ring_offset_m,
+                grip_offset_m=_numbers(grip_offset, "--grip-offset", 3) or default.grip_offset_m,
+                ring_pitch_rad=default.ring_pitch_rad if ring_pitch is None else _rad(ring_pitch),
+                grip_pitch_rad=default.grip_pitch_rad if grip_pitch is None else _rad(grip_pitch),
+            )
+        else:
+            from render_cams.kinect.placement import (
+                DEFAULT_HEIGHT_M,
+                KinectPlacementError,
+                look_at,
+                performer_target,
+                yaw_pitch_pose,
+            )
+
+            pos_xyz = _numbers(sensor_pos, "--sensor-pos", 3)
+            look_xyz = _numbers(sensor_look_at, "--sensor-look-at", 3)
+            height = DEFAULT_HEIGHT_M if sensor_height is None else sensor_height
+            if pos_xyz is not None and pos_xyz[2] < 0:
+                raise KinectPlacementError(f"--sensor-pos z = {pos_xyz[2]} m is below the floor")
+            if not (math.isfinite(height) and 0.0 <= height <= 3.0):
+                raise KinectPlacementError(f"--sensor-height must be in [0, 3] m, got {height}")
+            pose = None  # the automatic set-up, at --sensor-height
+            if sensor_yaw is not None or sensor_pitch is not None:
+                pose = yaw_pitch_pose(pos_xyz, _rad(sensor_yaw or 0.0), _rad(sensor_pitch or 0.0))
+            elif look_xyz is not None:
+                pose = look_at(pos_xyz, look_xyz)
+
         # A built-in motion is generated long enough for the range asked.
         generate_s = end_at if isinstance(end_at, float) else None
         generate_s = generate_s or start + (duration_s or DEFAULT_DURATION_S)
@@ -236,42 +280,16 @@ def register(app: typer.Typer) -> None:
         body, m = body_and_motion(m, None)
         t0 = time.perf_counter()
         if device == "fisheye":
-            from render_cams.fisheye.model import FisheyeModel
-            from render_cams.fisheye.rig import Mount
             from render_cams.fisheye.sequence import render_fisheye_sequence
 
-            model = FisheyeModel.from_fov(*fov_hv, *size_wh)
-            defaults = Mount()
-            mount = Mount(
-                ring_offset_m=ring_xyz or defaults.ring_offset_m,
-                grip_offset_m=grip_xyz or defaults.grip_offset_m,
-                ring_pitch_rad=defaults.ring_pitch_rad
-                if ring_pitch is None
-                else math.radians(ring_pitch),
-                grip_pitch_rad=defaults.grip_pitch_rad
-                if grip_pitch is None
-                else math.radians(grip_pitch),
-            )
             summary = render_fisheye_sequence(
                 m, out, seed=seed, model=model, body=body, mount=mount
             )
         else:
-            from render_cams.kinect.placement import (
-                DEFAULT_HEIGHT_M,
-                look_at,
-                performer_target,
-                yaw_pitch_pose,
-            )
             from render_cams.kinect.sequence import render_kinect_sequence
 
-            if pos_xyz is None:
-                pose = None  # the automatic set-up, at --sensor-height
-            elif sensor_yaw is not None or sensor_pitch is not None:
-                pose = yaw_pitch_pose(
-                    pos_xyz, math.radians(sensor_yaw or 0.0), math.radians(sensor_pitch or 0.0)
-                )
-            else:
-                pose = look_at(pos_xyz, look_xyz if look_xyz is not None else performer_target(m))
+            if pos_xyz is not None and pose is None:  # aimed at the performer
+                pose = look_at(pos_xyz, performer_target(m))
             summary = render_kinect_sequence(
                 m,
                 out,
@@ -279,7 +297,7 @@ def register(app: typer.Typer) -> None:
                 seed=seed,
                 sensor_pose=pose,
                 body=body,
-                sensor_height_m=DEFAULT_HEIGHT_M if sensor_height is None else sensor_height,
+                sensor_height_m=height,
             )
         elapsed = time.perf_counter() - t0
         summary = dict(summary)
