@@ -6,8 +6,10 @@ Writes, under ``out_dir``:
   bad frames injected (ControllerPose §4.2, about 1 in 50) when ``bad_frame_rate > 0``;
 - ``<camera>/NNNNNN_range.png``: 16-bit range along each pixel's ray in millimetres (0 = none);
 - ``keypoints.json``: seed, camera models and one self-describing record per camera frame
-  (:mod:`render_cams.fisheye.records`), incl. the bad-frame ground truth; no timings or
-  absolute paths, so that the same motion and seed give the same bytes in any folder;
+  (:mod:`render_cams.fisheye.records`), incl. the bad-frame ground truth and the occlusion
+  flags (``occluded``, ``lens_blocked``, ``mean_luminance``: a camera inside or against the
+  body records a dark frame, :mod:`render_cams.fisheye.occlusion`); no timings or absolute
+  paths, so that the same motion and seed give the same bytes in any folder;
 - ``fisheye.mp4``: the four cameras tiled 2x2, for a person to watch.
 
 Frames are rendered at the sensor's 30 Hz (ControllerPose §4.1 cameras); ``scale`` shrinks
