@@ -64,6 +64,12 @@ def test_frames_out_of_range_are_not_tracked_not_an_error():
     assert lost.any() and not lost.all()
     assert np.all(depth[lost] > get_sensor("kinect-v2").range_m[1] - 0.5)  # the far end
     assert np.all(np.isfinite(stream.positions))
+    # The recorded frame has no body and no joint positions, as the SDKs report it.
+    frame = stream.frame_dict(int(np.flatnonzero(lost)[0]))
+    assert frame["body_tracked"] is False
+    assert all(j["position_world_m"] is None for j in frame["joints"])
+    assert {j["tracking_state"] for j in frame["joints"]} == {"NOT_TRACKED"}
+    assert stream.frame_dict(int(np.flatnonzero(~lost)[0]))["body_tracked"] is True
     # Noise is not added to joints the sensor does not report.
     noisy = kinect_skeleton(motion, "kinect-v2", pose, seed=1)
     np.testing.assert_array_equal(noisy.positions[lost], stream.positions[lost])
