@@ -71,12 +71,17 @@ from scipy.ndimage import gaussian_filter1d
 
 from avatar_models.body17 import BODY17
 from avatar_models.errors import MotionValueError
-from sim.soles import FEET, box_corners, corner_positions, sole_boxes
+from sim.soles import (
+    ANKLE_SITES,
+    box_corners,
+    corner_positions,
+    foot_bodies,
+    sole_boxes,
+    thigh_bodies,
+)
 
 ROOT_DOF = 6
 QP_SOLVER = "daqp"
-THIGHS = ("Bip01 L Thigh", "Bip01 R Thigh")
-ANKLE_SITES = ("l_ankle", "r_ankle")
 GRAVITY = 9.81
 
 
@@ -345,8 +350,10 @@ class Tracker:
         self.ankles = np.array(
             [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, n) for n in ANKLE_SITES]
         )
-        self.feet = [model.body(name).id for name in FEET]
-        hips = [np.flatnonzero(model.jnt_bodyid == model.body(name).id) for name in THIGHS]
+        self.feet = [model.body(name).id for name in foot_bodies(model)]
+        hips = [
+            np.flatnonzero(model.jnt_bodyid == model.body(name).id) for name in thigh_bodies(model)
+        ]
         self.hip_dof = [model.jnt_dofadr[j] for j in hips]
         self.hip_qadr = [model.jnt_qposadr[j] for j in hips]
         # Sole boxes: the box geoms of the feet and the bodies below them (toes), with their

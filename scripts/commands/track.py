@@ -50,7 +50,7 @@ def register(app: typer.Typer) -> None:
         """Physics tracking of a motion by the MuJoCo humanoid. Exit 1 if it falls."""
         from avatar_models.errors import MotionValueError
         from scripts.results import atomic_dir
-        from sim.plausibility import body_and_motion
+        from sim.humanoid import humanoid_for
         from sim.sampling import SearchSettings, timed_tracking
         from sim.tracking import looped
         from sim.tracking_report import write_outputs
@@ -60,15 +60,16 @@ def register(app: typer.Typer) -> None:
         if samples < 1 or beam < 1:
             raise MotionValueError("--samples and --beam must be at least 1")
         m = load_motion_arg(motion, unit, seed, duration_s=seconds or 10.0)
-        body, m = body_and_motion(m, None, level_feet=True)
-        qpos = body.qpos_from_motion(m)
+        humanoid = humanoid_for(m, level_feet=True)
+        qpos = humanoid.qpos
         if seconds is not None:
             qpos = looped(qpos, m.fps, seconds)
         summary_extra = {"motion": motion, "seed": seed, "fps": m.fps}
-        if "retarget_residual_cm" in m.meta:
-            summary_extra["retarget_residual_cm"] = m.meta["retarget_residual_cm"]
+        summary_extra |= humanoid.summary()
         search = None if plain else SearchSettings(samples=samples, beam=beam, seed=seed)
-        result, summary = timed_tracking(body, qpos, m.fps, search, progress_bar=True)
+        result, summary = timed_tracking(
+            humanoid.model_copy(), qpos, m.fps, search, progress_bar=True
+        )
         summary |= summary_extra
         wall = summary["wall_s"]
         table = Table(title=f"physics tracking ({summary['mode']}): {motion}")
@@ -95,7 +96,7 @@ def register(app: typer.Typer) -> None:
         if export is not None:
             from sim.export import export_replay
 
-            export_replay(body, result.qpos, m.fps, export)
+            export_replay(humanoid, result.qpos, m.fps, export)
             console.print(
                 f"MuJoCo viewer files in {export}/ (python -m mujoco.viewer --mjcf "
                 f"{export}/replay.xml)"
