@@ -275,9 +275,10 @@ def register(app: typer.Typer) -> None:
 
         # The humanoid for this motion, built once and passed to the device (a foreign rig,
         # e.g. Bandai's, is retargeted onto it).
-        from sim.plausibility import body_and_motion
+        from sim.humanoid import humanoid_for
 
-        body, m = body_and_motion(m, None)
+        humanoid = humanoid_for(m)
+        body, m = humanoid.body, humanoid.motion
         t0 = time.perf_counter()
         if device == "fisheye":
             from render_cams.fisheye.sequence import render_fisheye_sequence

@@ -122,9 +122,10 @@ def test_real_takes_stay_tracked_and_in_view(mocap_dir, clip, device):
     stretch (2.9 m for Kinect V2, 2.3 m for Azure NFOV, less the body's own depth) of a path
     towards the sensor is seen whole. The sensor keeps such a stretch in view, every joint
     inside range and view is reported, and a part of the take that fits is tracked whole."""
-    from sim.plausibility import body_and_motion  # the humanoid for a foreign rig (Bandai)
+    from sim.humanoid import humanoid_for  # the humanoid for a foreign rig (Bandai)
 
-    body, motion = body_and_motion(load_motion(mocap_dir / clip), None)
+    humanoid = humanoid_for(load_motion(mocap_dir / clip))
+    body, motion = humanoid.body, humanoid.motion
     motion = motion[:: max(1, int(round(motion.fps / 30)))]
     sensor = get_sensor(device)
     near, far = sensor.range_m
