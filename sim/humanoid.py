@@ -19,7 +19,6 @@ Shapes: ``T`` frames, ``nq`` MuJoCo position coordinates.
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass
 
 import mujoco
@@ -45,7 +44,8 @@ class Humanoid:
             for an own rig).
         source: the motion as given (after any height scaling).
         mjcf: the body's MJCF, generated once.
-        model: ``mjcf`` compiled once; read it, do not edit it (see :meth:`model_copy`).
+        model: ``mjcf`` compiled once, shared by every stage: read it, do not edit it (the
+            tracker works on a copy of its own).
         levelled: whether stance feet were levelled for tracking.
     """
 
@@ -61,10 +61,6 @@ class Humanoid:
     @property
     def retargeted(self) -> bool:
         return self.motion is not self.source
-
-    def model_copy(self) -> mujoco.MjModel:
-        """A copy of :attr:`model` for a caller that edits its model (the tracker does)."""
-        return copy.copy(self.model)
 
     def for_tracking(self) -> Humanoid:
         """This humanoid with stance feet levelled for physics tracking (module docstring);

@@ -260,8 +260,7 @@ def timed_tracking(
     search: SearchSettings | None,
     progress_bar: bool = False,
 ) -> tuple[TrackingResult, dict]:
-    """Track ``qpos_ref (T, nq)`` on ``model`` (a humanoid's, which the tracker modifies: pass
-    a copy, e.g. :meth:`sim.humanoid.Humanoid.model_copy`): by :func:`search_track` with
+    """Track ``qpos_ref (T, nq)`` on (a copy of) ``model``: by :func:`search_track` with
     ``search``, or by the plain controller when it is ``None``. Returns the result and its
     summary (:meth:`TrackingResult.summary`) with the mode, the search's settings and
     simulated seconds, the wall time and the speed next to real time."""

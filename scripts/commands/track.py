@@ -67,9 +67,7 @@ def register(app: typer.Typer) -> None:
         summary_extra = {"motion": motion, "seed": seed, "fps": m.fps}
         summary_extra |= humanoid.summary()
         search = None if plain else SearchSettings(samples=samples, beam=beam, seed=seed)
-        result, summary = timed_tracking(
-            humanoid.model_copy(), qpos, m.fps, search, progress_bar=True
-        )
+        result, summary = timed_tracking(humanoid.model, qpos, m.fps, search, progress_bar=True)
         summary |= summary_extra
         wall = summary["wall_s"]
         table = Table(title=f"physics tracking ({summary['mode']}): {motion}")

@@ -19,12 +19,13 @@ from scripts.cli import app
 runner = CliRunner()
 
 CLIPS = {
-    "cmu": "cmu/09_01.bvh",
-    "bandai-1": "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh",
-    "bandai-2": "bandai/dataset-2/data/dataset-2_wave-right-hand_normal_001.bvh",
+    "cmu": ("cmu/09_01.bvh", 0.05),  # a 1.24 s run; its frame 0 is a T-pose
+    "bandai-1": ("bandai/dataset-1/data/dataset-1_walk_normal_001.bvh", 1.0),
+    "bandai-2": ("bandai/dataset-2/data/dataset-2_wave-right-hand_normal_001.bvh", 1.0),
 }
-SLICE_S = (1.0, 2.2)
-"""A slice in the middle of the clip (past CMU's leading T-pose), long enough for every stage."""
+"""Source -> clip and the second its slice starts at."""
+SLICE_S = 1.1
+"""Slice length: enough for every stage (a 0.5 s track loops a gait cycle of at least 0.8 s)."""
 COMMANDS = ("info", "convert", "check", "track", "fisheye", "kinect-v2", "azure-kinect", "run")
 
 SCENARIO = """
@@ -34,6 +35,9 @@ seed = 0
 source = "{path}"
 {builtin}duration_s = 1.0
 fps = 90.0
+[report]
+picture_frames = 3
+gif = false
 [devices]
 vr = true
 noise = "realistic"
@@ -55,10 +59,11 @@ def sliced(mocap_dir, tmp_path_factory) -> dict[str, str]:
     """Source name -> the MOTION argument: a BVH slice of the real clip, or builtin:walk."""
     out = {"builtin": "builtin:walk"}
     folder = tmp_path_factory.mktemp("clips")
-    for name, rel in CLIPS.items():
+    for name, (rel, start_s) in CLIPS.items():
         motion = load_motion(mocap_dir / rel)
-        a, b = (int(round(s * motion.fps)) for s in SLICE_S)
-        out[name] = str(save_motion(motion[a:b], folder / f"{name}.bvh"))
+        a = int(round(start_s * motion.fps))
+        sliced = motion[a : a + int(round(SLICE_S * motion.fps))]
+        out[name] = str(save_motion(sliced, folder / f"{name}.bvh"))
     return out
 
 
