@@ -159,6 +159,28 @@ def pinhole_K(fov_x_rad: float, width: int, height: int) -> np.ndarray:
     return np.array([[f, 0.0, 0.5 * (width - 1)], [0.0, f, 0.5 * (height - 1)], [0, 0, 1.0]])
 
 
+def body_for_motion(motion: Motion, body: BodyDescription | None = None) -> BodyDescription:
+    """The body to pose with ``motion``: ``body`` itself when given (the humanoid the caller
+    built once for this motion; ``motion`` must be on its skeleton), else one built from the
+    motion's skeleton (which must then be an upright humanoid rig).
+
+    Raises:
+        SceneError: ``motion`` is not on ``body``'s skeleton.
+        BodyError: no body can be built from the motion's skeleton.
+    """
+    if body is None:
+        return build_body(motion.skeleton)
+    if not isinstance(body, BodyDescription):
+        raise SceneError(f"body must be a BodyDescription, got {type(body).__name__}")
+    if not motion.skeleton.same_topology(body.skeleton):
+        raise SceneError(
+            f"the motion is on skeleton {motion.skeleton.name!r} ({motion.skeleton.n_joints} "
+            f"joints), not on the body's {body.skeleton.name!r} "
+            f"({body.skeleton.n_joints} joints); retarget it onto the body first"
+        )
+    return body
+
+
 class _BodyProgramCache(ShaderProgramCache):
     """pyrender's shader cache with BodyScene's shaders swapped in: the label pass always, the
     matte colour shader when asked."""
@@ -254,7 +276,8 @@ class BodyScene:
     """The posed body (and floor, lights, optional room) ready to render from any camera.
 
     Args:
-        body: a :class:`BodyDescription`, or a skeleton to build one from.
+        body: a :class:`BodyDescription` (the humanoid built once for the motion, see
+            :func:`body_for_motion`), or a skeleton to build one from.
         clothing: colours per body region.
         floor: add a 20 m square floor at z = 0.
         room: optional textured wall around the user.

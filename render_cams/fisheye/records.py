@@ -22,6 +22,9 @@ def frame_record(
     visible: np.ndarray,
     conf: np.ndarray,
     bad_frame: bool = False,
+    lens_blocked: float = 0.0,
+    occluded: bool = False,
+    mean_luminance: float | None = None,
 ) -> dict:
     """JSON-ready record of one camera frame.
 
@@ -31,6 +34,10 @@ def frame_record(
         uv: ``(17, 2)`` pixels (``cv2.fisheye.projectPoints`` of the joints);
         in_image, visible: ``(17,)`` bool; conf: ``(17,)``.
         bad_frame: ground truth: this frame was corrupted (interference, sync loss).
+        lens_blocked: share of the image circle covered by the body at touching distance (1:
+            the camera centre is inside the body); occluded: the frame shows (almost) nothing
+            but that (:mod:`render_cams.fisheye.occlusion`); mean_luminance: mean grey level
+            (0-255) of the image circle as recorded.
     """
     return {
         "camera": camera,
@@ -39,6 +46,9 @@ def frame_record(
         "time_s": float(time_s),
         "world_to_camera": np.asarray(world_to_camera).tolist(),
         "bad_frame": bool(bad_frame),
+        "occluded": bool(occluded),
+        "lens_blocked": round(float(lens_blocked), 4),
+        **({} if mean_luminance is None else {"mean_luminance": round(float(mean_luminance), 2)}),
         "joints": list(BODY17),
         "joints_world": np.round(joints_world, 6).tolist(),
         "keypoints_px": np.round(uv, 4).tolist(),

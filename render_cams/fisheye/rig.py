@@ -76,9 +76,56 @@ class ControllerCamera:
         )
 
 
-def controller_cameras(controllers: Sequence[str] = CONTROLLERS) -> tuple[ControllerCamera, ...]:
-    """The ring and grip cameras of each controller, in ``(controller, ring/grip)`` order."""
-    mounts = (("ring", RING_OFFSET_M, PITCH_RAD), ("grip", GRIP_BOTTOM_OFFSET_M, -PITCH_RAD))
+class CameraMountError(AvatarsimError, ValueError):
+    """A camera mount that no controller could have (far from it, NaN, pitched past vertical)."""
+
+
+MAX_MOUNT_OFFSET_M = 0.25
+"""A camera mounted on a controller (about 15 cm long) sits within this of the palm centre."""
+
+
+@dataclass(frozen=True)
+class Mount:
+    """Where the two cameras of a controller sit, in the controller frame (+X pointing, +Y
+    left, +Z up; metres) and how far each is pitched from looking straight back along -X
+    (radians; up for the ring, down for the grip with the defaults). The same mount is used
+    on both controllers (the left one is not mirrored: both controllers are built alike).
+
+    Defaults: the plausible Quest 2 placement of the module docstring.
+    """
+
+    ring_offset_m: tuple[float, float, float] = tuple(RING_OFFSET_M)
+    grip_offset_m: tuple[float, float, float] = tuple(GRIP_BOTTOM_OFFSET_M)
+    ring_pitch_rad: float = float(PITCH_RAD)
+    grip_pitch_rad: float = float(-PITCH_RAD)
+
+    def __post_init__(self) -> None:
+        for name in ("ring_offset_m", "grip_offset_m"):
+            offset = np.asarray(getattr(self, name), float)
+            if offset.shape != (3,) or not np.all(np.isfinite(offset)):
+                raise CameraMountError(f"{name} must be 3 finite numbers (metres), got {offset}")
+            if np.linalg.norm(offset) > MAX_MOUNT_OFFSET_M:
+                raise CameraMountError(
+                    f"{name} {offset.tolist()} m is {np.linalg.norm(offset):.2f} m from the "
+                    f"controller's grip; a camera on a controller is within "
+                    f"{MAX_MOUNT_OFFSET_M} m of it"
+                )
+        for name in ("ring_pitch_rad", "grip_pitch_rad"):
+            pitch = float(getattr(self, name))
+            if not (np.isfinite(pitch) and abs(pitch) <= 0.5 * np.pi):
+                raise CameraMountError(f"{name} must be in [-90, 90] deg, got {np.degrees(pitch)}")
+
+
+def controller_cameras(
+    controllers: Sequence[str] = CONTROLLERS, mount: Mount | None = None
+) -> tuple[ControllerCamera, ...]:
+    """The ring and grip cameras of each controller, in ``(controller, ring/grip)`` order,
+    mounted as ``mount`` says (default :class:`Mount`)."""
+    mount = mount or Mount()
+    mounts = (
+        ("ring", np.asarray(mount.ring_offset_m, float), mount.ring_pitch_rad),
+        ("grip", np.asarray(mount.grip_offset_m, float), mount.grip_pitch_rad),
+    )
     return tuple(
         ControllerCamera(f"{c}/{where}", c, offset, looking_back(pitch))
         for c in controllers

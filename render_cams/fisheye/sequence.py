@@ -6,8 +6,10 @@ Writes, under ``out_dir``:
   bad frames injected (ControllerPose §4.2, about 1 in 50) when ``bad_frame_rate > 0``;
 - ``<camera>/NNNNNN_range.png``: 16-bit range along each pixel's ray in millimetres (0 = none);
 - ``keypoints.json``: seed, camera models and one self-describing record per camera frame
-  (:mod:`render_cams.fisheye.records`), incl. the bad-frame ground truth; no timings or
-  absolute paths, so that the same motion and seed give the same bytes in any folder;
+  (:mod:`render_cams.fisheye.records`), incl. the bad-frame ground truth and the occlusion
+  flags (``occluded``, ``lens_blocked``, ``mean_luminance``: a camera inside or against the
+  body records a dark frame, :mod:`render_cams.fisheye.occlusion`); no timings or absolute
+  paths, so that the same motion and seed give the same bytes in any folder;
 - ``fisheye.mp4``: the four cameras tiled 2x2, for a person to watch.
 
 Frames are rendered at the sensor's 30 Hz (ControllerPose §4.1 cameras); ``scale`` shrinks
@@ -26,10 +28,10 @@ import imageio.v2 as imageio
 import numpy as np
 
 from avatar_models import Motion
-from avatar_models.body import build_body
+from avatar_models.body import BodyDescription
 from avatar_models.rigs import body17_positions
 from render_cams.device import DeviceError, motion_at_rate, resolve_seed
-from render_cams.fisheye import bad_frames
+from render_cams.fisheye import bad_frames, occlusion
 from render_cams.fisheye.keypoints import (
     DetectorNoise,
     confidence,
@@ -43,12 +45,13 @@ from render_cams.fisheye.records import frame_record
 from render_cams.fisheye.render import FisheyeRenderer
 from render_cams.fisheye.rig import (
     ControllerCamera,
+    Mount,
     camera_poses,
-    check_cameras_outside,
     controller_cameras,
+    inside_body,
 )
 from render_cams.fisheye.stitch import stitch_params
-from render_cams.scene import BodyScene
+from render_cams.scene import BodyScene, body_for_motion
 
 CAMERA_RATE_HZ = 30.0
 
@@ -65,13 +68,24 @@ def render_fisheye_sequence(
     controllers: Sequence[str] = ("left_controller", "right_controller"),
     video: bool = True,
     stitch: bool = True,
+    body: BodyDescription | None = None,
+    mount: Mount | None = None,
 ) -> dict:
     """Render every controller camera over ``motion`` into ``out_dir``; return a summary
-    ``{"frames", "cameras", "fps_rendered", "bad_frames", "seed", "out_dir"}``.
+    ``{"frames", "cameras", "fps_rendered", "bad_frames", "occluded_frames", "seed",
+    "out_dir"}``.
+
+    Args:
+        body: the humanoid to render (built once by the caller for this motion); ``motion``
+            must be on its skeleton. Default: a body built from ``motion``'s skeleton.
+        mount: where the cameras sit on the controllers (default :class:`Mount`).
+
+    A camera inside or against the body records a dark, occluded frame, flagged in its
+    record (:mod:`render_cams.fisheye.occlusion`); the clip is rendered all the same.
 
     Raises:
-        IntrinsicsError: impossible camera model; CameraInsideBodyError: a camera inside the
-        body; DeviceError: bad rate or scale; RigError: a skeleton without a body17 map.
+        IntrinsicsError: impossible camera model; DeviceError: bad rate or scale; RigError: a
+        skeleton without a body17 map; SceneError: ``motion`` not on ``body``'s skeleton.
     """
     seed = resolve_seed(seed)
     if not (np.isfinite(scale) and 0.05 <= scale <= 4.0):
@@ -80,14 +94,15 @@ def render_fisheye_sequence(
     if scale != 1.0:
         model = model.scaled(scale)
     sampled = motion_at_rate(motion, rate_hz)
-    body = build_body(sampled.skeleton)
-    cameras = controller_cameras(controllers)
+    body = body_for_motion(sampled, body)
+    cameras = controller_cameras(controllers, mount)
     poses = camera_poses(sampled, cameras)  # (T, C, 4, 4)
-    check_cameras_outside(body, sampled, poses)
+    inside = inside_body(body, *sampled.fk(), poses[..., :3, 3])  # (T, C): lens covered
     joints = body17_positions(sampled)  # (T, 17, 3)
     thickness = joint_thickness(body)
-    rng_inject, rng_noise = (
-        np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(2)
+    # The third stream (dark frames) leaves the first two as they were with two.
+    rng_inject, rng_noise, rng_dark = (
+        np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)
     )
 
     out = Path(out_dir)
@@ -96,14 +111,22 @@ def render_fisheye_sequence(
         (out / name).mkdir(parents=True, exist_ok=True)
     n_frames, n_cams = poses.shape[:2]
     images = np.zeros((n_cams, n_frames, model.height, model.width, 3), np.uint8)
-    records: list[dict] = []
+    blocked = np.zeros((n_cams, n_frames))
+    records: list[tuple] = []
     start = time.perf_counter()
     with BodyScene(body) as scene:
         renderer = FisheyeRenderer(scene, model)
+        circle = renderer.maps.range_scale > 0
         for t in range(n_frames):  # rendering is inherently per frame
             scene.update(sampled, t)
             for c in range(n_cams):
-                color, range_m = renderer.render(poses[t, c])
+                if inside[t, c]:
+                    color = occlusion.dark_frame(model.height, model.width, rng_dark)
+                    range_m = np.zeros((model.height, model.width), np.float32)
+                    blocked[c, t] = 1.0
+                else:
+                    color, range_m = renderer.render(poses[t, c])
+                    color, blocked[c, t] = occlusion.block_lens(color, range_m, circle)
                 images[c, t] = color
                 range_mm = np.clip(np.rint(range_m * 1000.0), 0, 65535).astype(np.uint16)
                 cv2.imwrite(str(out / names[c] / f"{t:06d}_range.png"), range_mm)
@@ -111,7 +134,7 @@ def render_fisheye_sequence(
                     model, poses[t, c][None], joints[t][None]
                 )
                 vis = visibility(uv[0], in_image[0], joint_range[0], range_m, thickness)
-                records.append((t, c, uv[0], in_image[0], vis))
+                records.append((t, c, uv[0], in_image[0], vis & ~inside[t, c]))
     elapsed = time.perf_counter() - start
 
     truth = np.zeros((n_cams, n_frames), bool)
@@ -119,6 +142,7 @@ def render_fisheye_sequence(
         images[c], truth[c], _ = bad_frames.inject(images[c], rng_inject, bad_frame_rate)
         for t in range(n_frames):
             cv2.imwrite(str(out / names[c] / f"{t:06d}.png"), images[c, t][..., ::-1])
+    occluded = blocked >= occlusion.OCCLUDED_FRACTION  # (C, T)
     w2c = world_to_camera(poses)
     frames_json = []
     for t, c, uv, in_image, vis in records:
@@ -139,16 +163,23 @@ def render_fisheye_sequence(
                 vis,
                 conf,
                 bad_frame=bool(truth[c, t]),
+                lens_blocked=blocked[c, t],
+                occluded=bool(occluded[c, t]),
+                mean_luminance=occlusion.mean_luminance(images[c, t], circle),
             )
         )
     flagged = np.stack([bad_frames.detect(images[c]) for c in range(n_cams)])
+    # Occluded frames are dark for a reason the injected faults do not cover: the detector
+    # is scored on the other frames only.
+    clear = ~occluded
     # The data record depends on the seed alone (same seed => same bytes); the wall-clock
     # speed and the folder it was written to go in the returned summary only.
     recording = {
         "frames": int(n_frames),
         "cameras": names,
         "fps": rate_hz,
-        "bad_frames": bad_frames.precision_recall(truth.ravel(), flagged.ravel()),
+        "bad_frames": bad_frames.precision_recall(truth[clear], flagged[clear]),
+        "occluded_frames": {name: int(occluded[c].sum()) for c, name in enumerate(names)},
         "seed": seed,
         "model": model.as_dict(),
     }

@@ -9,7 +9,12 @@ and 30 Hz skeleton streams (issue 4, item 6).
 """
 
 from render_cams.kinect.noise import DepthNoiseModel
-from render_cams.kinect.placement import KinectPlacementError, default_sensor_pose, look_at
+from render_cams.kinect.placement import (
+    KinectPlacementError,
+    default_sensor_pose,
+    look_at,
+    yaw_pitch_pose,
+)
 from render_cams.kinect.sensors import SENSORS, DepthSensor, KinectError, get_sensor
 from render_cams.kinect.skeleton import (
     KinectSkeletonStream,
@@ -31,4 +36,5 @@ __all__ = [
     "get_sensor",
     "kinect_skeleton",
     "look_at",
+    "yaw_pitch_pose",
 ]

@@ -19,12 +19,17 @@ import cv2
 import numpy as np
 
 from avatar_models import Motion
+from avatar_models.body import BodyDescription
 from render_cams.device import motion_at_rate, resolve_seed
 from render_cams.kinect.depth import KinectDepthCamera, colourise, write_png
-from render_cams.kinect.placement import default_sensor_pose
+from render_cams.kinect.placement import (
+    DEFAULT_HEIGHT_M,
+    default_sensor_pose,
+    performer_distance,
+)
 from render_cams.kinect.sensors import KinectError, get_sensor
 from render_cams.kinect.skeleton import KinectSkeletonStream, TrackingState, kinect_skeleton
-from render_cams.scene import BodyScene
+from render_cams.scene import BodyScene, body_for_motion
 
 _STATE_BGR = {
     TrackingState.TRACKED: (80, 220, 80),
@@ -41,6 +46,8 @@ def render_kinect_sequence(
     max_frames: int | None = None,
     depth_noise: Any = "default",
     skeleton_noise: Any = "default",
+    body: BodyDescription | None = None,
+    sensor_height_m: float = DEFAULT_HEIGHT_M,
 ) -> dict[str, Any]:
     """Record ``motion`` with a simulated Kinect at 30 Hz and write it to ``out_dir``.
 
@@ -49,9 +56,14 @@ def render_kinect_sequence(
         out_dir: output folder (created).
         device: a name of :data:`~render_cams.kinect.sensors.SENSORS`.
         seed: one seed for depth and skeleton noise; recorded in ``recording.json``.
-        sensor_pose: ``(4, 4)`` camera-to-world (OpenCV axes); default 2 m in front, 1 m high.
+        sensor_pose: ``(4, 4)`` camera-to-world (OpenCV axes); default: set up for this take
+            by :func:`~render_cams.kinect.placement.default_sensor_pose` (in front of the
+            performer, the whole take in range and view where the range allows), at
+            ``sensor_height_m`` above the floor.
         max_frames: record at most this many frames (from the start).
         depth_noise, skeleton_noise: ``"default"``, a model, or ``None`` for clean output.
+        body: the humanoid built once for ``motion`` (``motion`` on its skeleton); default:
+            a body built from ``motion``'s skeleton.
 
     Returns:
         The ``recording.json`` contents (``frames``, ``fps``, paths...).
@@ -62,9 +74,15 @@ def render_kinect_sequence(
     sampled = motion_at_rate(motion, sensor.rate_hz)
     if max_frames is not None:
         sampled = sampled[: int(max_frames)]
-    pose = default_sensor_pose(sampled) if sensor_pose is None else np.asarray(sensor_pose, float)
+    body = body_for_motion(sampled, body)
+    placed = sensor_pose is None
+    pose = (
+        default_sensor_pose(sampled, sensor, sensor_height_m)
+        if placed
+        else np.asarray(sensor_pose, float)
+    )
     used_seed = resolve_seed(seed)
-    skeleton = kinect_skeleton(sampled, sensor, pose, used_seed, skeleton_noise)
+    skeleton = kinect_skeleton(sampled, sensor, pose, used_seed, skeleton_noise, body)
     camera = KinectDepthCamera(sensor, pose, depth_noise)
     rng = np.random.default_rng([used_seed, 1])  # the skeleton noise uses used_seed itself
     out = Path(out_dir)
@@ -77,7 +95,7 @@ def render_kinect_sequence(
         sensor.rate_hz,
         (sensor.width, sensor.height),
     )
-    with BodyScene(sampled.skeleton) as scene:
+    with BodyScene(body) as scene:
         for t in range(sampled.n_frames):
             scene.update(sampled, t)
             frame = camera.capture(scene, rng)
@@ -97,6 +115,10 @@ def render_kinect_sequence(
         "D": [0.0] * 5,
         "range_m": list(sensor.range_m),
         "camera_to_world": pose.tolist(),
+        "sensor_placement": "auto" if placed else "given",
+        "performer_depth_m_median": round(float(np.median(performer_distance(pose, sampled))), 4),
+        "tracked_fraction": round(float(np.mean(skeleton.states == TrackingState.TRACKED)), 4),
+        "not_tracked_frames": int(np.sum(np.all(skeleton.states == TrackingState.NOT_TRACKED, 1))),
         "world_to_camera": np.linalg.inv(pose).tolist(),
         "rig": skeleton.rig,
         "joint_names": list(skeleton.joint_names),

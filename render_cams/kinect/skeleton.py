@@ -30,13 +30,14 @@ import numpy as np
 from scipy.signal import lfilter
 
 from avatar_models import Motion, quat
-from avatar_models.body import build_body
+from avatar_models.body import BodyDescription
 from avatar_models.body17 import INDEX
 from avatar_models.rigs import Rig, identify_rig, load_rig
 from render_cams.device import motion_at_rate, resolve_seed
 from render_cams.kinect.capsules import posed_capsules
 from render_cams.kinect.placement import check_sensor_pose, default_sensor_pose
 from render_cams.kinect.sensors import DepthSensor, KinectError, get_sensor
+from render_cams.scene import body_for_motion
 
 
 class TrackingState(IntEnum):
@@ -120,7 +121,8 @@ class KinectSkeletonStream:
         rig: ``"kinect_v2"`` or ``"azure_kinect"``.
         joint_names: ``J`` names in the rig's order.
         timestamps: ``(T,)`` seconds.
-        positions: ``(T, J, 3)`` world metres (Z up), noise included.
+        positions: ``(T, J, 3)`` world metres (Z up), noise included; meaningless where
+            ``states`` is NotTracked (the JSON frames leave those out).
         orientations: ``(T, J, 4)`` world wxyz relative to the rig's T-pose.
         states: ``(T, J)`` int8 :class:`TrackingState`.
         sensor_pose: ``(4, 4)`` camera-to-world pose (OpenCV axes).
@@ -148,18 +150,30 @@ class KinectSkeletonStream:
         return opencv * np.array([-1.0, -1.0, 1.0])
 
     def frame_dict(self, t: int) -> dict[str, Any]:
-        """Frame ``t`` as a JSON-ready dict (positions in world and camera space)."""
+        """Frame ``t`` as a JSON-ready dict (positions in world and camera space).
+
+        As the SDKs report it: a NotTracked joint has no position (``null``), and a frame in
+        which no joint is tracked (the performer out of range or view) has no body
+        (``body_tracked: false``)."""
         cam = self.camera_space()[t]
+        states = self.states[t]
+
+        def where(values: np.ndarray, state: int) -> list[float] | None:
+            return None if state == TrackingState.NOT_TRACKED else np.round(values, 5).tolist()
+
         return {
             "timestamp_s": float(self.timestamps[t]),
             "rig": self.rig,
+            "body_tracked": bool(np.any(states != TrackingState.NOT_TRACKED)),
             "joints": [
                 {
                     "name": name,
-                    "position_world_m": np.round(self.positions[t, j], 5).tolist(),
-                    "position_camera_m": np.round(cam[j], 5).tolist(),
-                    "orientation_wxyz": np.round(self.orientations[t, j], 6).tolist(),
-                    "tracking_state": TrackingState(int(self.states[t, j])).name,
+                    "position_world_m": where(self.positions[t, j], states[j]),
+                    "position_camera_m": where(cam[j], states[j]),
+                    "orientation_wxyz": None
+                    if states[j] == TrackingState.NOT_TRACKED
+                    else np.round(self.orientations[t, j], 6).tolist(),
+                    "tracking_state": TrackingState(int(states[j])).name,
                 }
                 for j, name in enumerate(self.joint_names)
             ],
@@ -175,24 +189,36 @@ def kinect_skeleton(
     sensor_pose: np.ndarray | None = None,
     seed: int | np.random.Generator = 0,
     noise: SkeletonNoise | None | str = "default",
+    body: BodyDescription | None = None,
 ) -> KinectSkeletonStream:
     """The skeleton stream a Kinect at ``sensor_pose`` reports for ``motion`` at 30 Hz.
 
     Args:
         motion: any motion whose rig has a body17 map.
         device: a sensor name of :data:`~render_cams.kinect.sensors.SENSORS` or a sensor.
-        sensor_pose: ``(4, 4)`` camera-to-world; default :func:`default_sensor_pose`.
+        sensor_pose: ``(4, 4)`` camera-to-world; default :func:`default_sensor_pose` (set up
+            for this take).
         seed: randomness for the noise; recorded in ``meta``.
         noise: ``"default"`` (per-rig :data:`NOISE_BY_RIG`), a :class:`SkeletonNoise`, or
             ``None`` for exact joints.
+        body: the humanoid built once for ``motion`` (``motion`` on its skeleton), for the
+            occlusion tests; default: a body built from ``motion``'s skeleton.
+
+    Joints outside the sensor's range or field of view are NotTracked in that frame: no noise
+    is added to them and the JSON frames report no position for them.
 
     Raises:
-        UnknownDeviceError, KinectPlacementError (sensor inside the body), KinectError.
+        UnknownDeviceError, KinectPlacementError (sensor below the floor or inside the body
+        for the whole take), KinectError, SceneError (motion not on ``body``'s skeleton).
     """
     sensor = get_sensor(device)
     sampled = motion_at_rate(motion, sensor.rate_hz)
-    pose = default_sensor_pose(sampled) if sensor_pose is None else np.asarray(sensor_pose, float)
-    body = build_body(sampled.skeleton)
+    body = body_for_motion(sampled, body)
+    pose = (
+        default_sensor_pose(sampled, sensor)
+        if sensor_pose is None
+        else np.asarray(sensor_pose, float)
+    )
     check_sensor_pose(pose, body, sampled)
     rig = load_rig(sensor.rig)
     positions, orientations = rig_joints(sampled, rig)

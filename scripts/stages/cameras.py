@@ -32,8 +32,12 @@ def metrics_for(scenario: Scenario) -> set[str]:
 
 
 def window(ctx: RunContext):
-    middle = ctx.motion.n_frames // 2
-    return ctx.motion[middle : middle + max(2, int(round(WINDOW_S * ctx.motion.fps)))]
+    """A few frames mid-clip of the motion on the humanoid (the ground truth itself on an own
+    rig, its retargeting on a foreign one), and the humanoid's body to render."""
+    motion = ctx.motion if ctx.humanoid is None else ctx.humanoid.motion
+    body = None if ctx.humanoid is None else ctx.humanoid.body
+    middle = motion.n_frames // 2
+    return motion[middle : middle + max(2, int(round(WINDOW_S * motion.fps)))], body
 
 
 def panel(image: np.ndarray, label: str) -> np.ndarray:
@@ -53,13 +57,15 @@ def run(ctx: RunContext) -> None:
     spec = ctx.scenario.cameras
     if spec is None:
         return
-    clip = window(ctx)
+    clip, body = window(ctx)
     panels = []
     if spec.fisheye:
         from render_cams.fisheye.sequence import render_fisheye_sequence
 
         folder = ctx.out_dir / "cameras" / "fisheye"
-        summary = render_fisheye_sequence(clip, folder, seed=ctx.scenario.seed, video=False)
+        summary = render_fisheye_sequence(
+            clip, folder, seed=ctx.scenario.seed, video=False, body=body
+        )
         ctx.metrics["fisheye_fps_rendered"] = float(summary["fps_rendered"])
         for name in summary["cameras"]:
             panels.append(panel(iio.imread(folder / name / "000000.png"), name))
@@ -71,7 +77,9 @@ def run(ctx: RunContext) -> None:
 
         folder = ctx.out_dir / "cameras" / spec.kinect
         t0 = time.perf_counter()
-        summary = render_kinect_sequence(clip, folder, device=spec.kinect, seed=ctx.scenario.seed)
+        summary = render_kinect_sequence(
+            clip, folder, device=spec.kinect, seed=ctx.scenario.seed, body=body
+        )
         ctx.metrics["kinect_fps_rendered"] = summary["frames"] / (time.perf_counter() - t0)
         depth = read_depth_png(sorted((folder / "depth").glob("*.png"))[0])
         bgr = colourise(depth, get_sensor(spec.kinect).range_m)

@@ -8,6 +8,7 @@ import cv2
 import numpy as np
 
 from render_cams.kinect.depth import BODY_INDEX_NONE, read_depth_png
+from render_cams.kinect.placement import performer_distance
 from render_cams.kinect.sequence import render_kinect_sequence
 from tests.render_cams.builders import folder_bytes
 from tests.render_cams.kinect_builders import t_pose
@@ -20,8 +21,10 @@ def test_sequence_writes_depth_body_index_skeleton_and_preview(tmp_path):
     assert record["frames"] == 3 and record["seed"] == 5
     depth = read_depth_png(tmp_path / "a" / "depth" / "000002.png")
     assert depth.shape == (576, 640) and depth.dtype == np.uint16
-    assert 1900 < np.median(depth[depth > 0]) < 3900
     body_index = cv2.imread(str(tmp_path / "a" / "body_index" / "000002.png"), -1)
+    # The sensor was set up for the take: the body is at the distance it was placed at.
+    placed = performer_distance(np.array(record["camera_to_world"]), motion)[2]
+    assert abs(np.median(depth[body_index == 0]) / 1e3 - placed) < 0.3
     assert set(np.unique(body_index)) == {0, BODY_INDEX_NONE}
     frame = json.loads((tmp_path / "a" / "skeleton" / "000002.json").read_text())
     assert len(frame["joints"]) == 32

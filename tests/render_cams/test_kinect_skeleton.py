@@ -70,7 +70,10 @@ def test_orientations_turn_rest_bones_onto_current_bones():
 
 
 def test_t_pose_facing_the_sensor_is_fully_tracked():
-    stream = kinect_skeleton(t_pose(3), "kinect-v2", noise=None)
+    stream = kinect_skeleton(t_pose(3), "kinect-v2", noise=None)  # the automatic set-up
+    assert np.all(stream.states == TrackingState.TRACKED)
+    pose = look_at([2.0, 0.0, 1.0], [0.0, 0.0, 1.0])  # 2 m in front, 1 m high
+    stream = kinect_skeleton(t_pose(3), "kinect-v2", sensor_pose=pose, noise=None)
     assert np.all(stream.states == TrackingState.TRACKED)
     np.testing.assert_allclose(stream.camera_space()[0, 0], [0.0, 1.006 - 1.0, 2.0], atol=1e-9)
 

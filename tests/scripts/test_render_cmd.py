@@ -8,6 +8,9 @@ import imageio.v3 as iio
 import numpy as np
 from typer.testing import CliRunner
 
+from avatar_models.formats import save_motion
+from avatar_models.generator import generate
+from render_cams.kinect.placement import performer_distance
 from scripts.cli import app
 
 runner = CliRunner()
@@ -34,10 +37,87 @@ def test_kinect_render_writes_depth_in_millimetres(tmp_path):
     summary = json.loads((tmp_path / "r.json").read_text())
     assert summary["frames"] == 7 and summary["fps_rendered"] > 0  # 0.2 s at 30 Hz
     depth = iio.imread(sorted((out / "depth").glob("*.png"))[0])
+    body_index = iio.imread(sorted((out / "body_index").glob("*.png"))[0])
     assert depth.dtype == np.uint16 and depth.shape == (424, 512)
-    body = depth[depth > 0]
-    # The user stands about 2 m from the sensor (default pose): body and floor in range.
-    assert 500 <= np.median(body) <= 4500
+    # The body is where the sensor was set up: the pelvis's depth from the recorded pose and
+    # the same built-in motion, within 0.3 m (the body's own depth and the noise).
+    pose = np.array(json.loads((out / "recording.json").read_text())["camera_to_world"])
+    placed = performer_distance(pose, generate("wave", duration_s=0.2, seed=0)[:1])[0]
+    assert 1.0 < placed < 4.0
+    body = depth[(body_index == 0) & (depth > 0)]
+    assert body.size > 1000
+    assert abs(np.median(body) / 1e3 - placed) < 0.3
+
+
+def test_sensor_pose_and_frame_range_options(tmp_path):
+    out = tmp_path / "k"
+    args = ["render", "builtin:walk", "--device", "azure-kinect", "--out", str(out)]
+    result = runner.invoke(
+        app,
+        [
+            *args,
+            "--start",
+            "0.5",
+            "--end",
+            "1.0",
+            "--sensor-pos",
+            "2.5,0,0.8",
+            "--sensor-yaw",
+            "180",
+        ],
+    )
+    assert result.exit_code == 0, result.output
+    record = json.loads((out / "recording.json").read_text())
+    assert record["frames"] == 16 and record["sensor_placement"] == "given"  # 0.5 s at 30 Hz
+    pose = np.array(record["camera_to_world"])
+    np.testing.assert_allclose(pose[:3, 3], [2.5, 0.0, 0.8])
+    np.testing.assert_allclose(pose[:3, 2], [-1.0, 0.0, 0.0], atol=1e-9)
+    fish = runner.invoke(
+        app,
+        ["render", "builtin:walk", "--out", str(tmp_path / "f"), "--size", "64,48",
+         "--end", "0.1", "--ring-offset", "0.03,0,0.05", "--grip-pitch", "-40"],
+    )  # fmt: skip
+    assert fish.exit_code == 0, fish.output
+
+
+def test_options_of_another_device_and_bad_ranges_exit_2(tmp_path):
+    cases = [
+        (["--device", "kinect-v2", "--fov", "150,120"], "--fov only apply to --device fisheye"),
+        (["--device", "azure-kinect", "--ring-offset", "0,0,0.1"], "--ring-offset only apply"),
+        (["--sensor-pos", "2,0,1"], "only apply to a Kinect device"),
+        (["--device", "kinect-v2", "--sensor-yaw", "90"], "need --sensor-pos"),
+        (["--device", "kinect-v2", "--sensor-pos", "2,0"], "three numbers"),
+        (
+            [
+                "--device",
+                "kinect-v2",
+                "--sensor-pos",
+                "2,0,1",
+                "--sensor-look-at",
+                "0,0,1",
+                "--sensor-pitch",
+                "3",
+            ],
+            "not both",
+        ),  # fmt: skip
+        (["--device", "kinect-v2", "--sensor-pos", "2,0,-1"], "below the floor"),
+        (["--end", "1", "--duration-s", "1"], "not both"),
+        (["--start", "1", "--end", "0.5"], "after --start"),
+        (["--end", "soon"], "seconds or 'end'"),
+        (["--ring-offset", "0.5,0,0"], "within"),
+    ]
+    for extra, message in cases:
+        result = runner.invoke(app, ["render", "builtin:walk", "--out", str(tmp_path), *extra])
+        assert result.exit_code == 2, (extra, result.output)
+        assert message in result.stderr, (extra, result.stderr)
+
+
+def test_frame_range_past_a_file_clip_exits_2(tmp_path):
+    clip = save_motion(generate("walk", duration_s=1.0, seed=0), tmp_path / "walk.npz")
+    late = runner.invoke(app, ["render", str(clip), "--start", "5", "--out", str(tmp_path / "o")])
+    assert late.exit_code == 2 and "past the clip's end" in late.stderr
+    long = runner.invoke(app, ["render", str(clip), "--end", "3", "--out", str(tmp_path / "o")])
+    assert long.exit_code == 2 and "--end end" in long.stderr
 
 
 def test_unknown_device_and_activity_exit_2(tmp_path):
