@@ -242,26 +242,24 @@ class _BodyRenderer(pyrender.Renderer):
 
 
 class _Contexts:
-    """Counts the live GL contexts of all scenes. With EGL, every context lives on one shared
-    display, and pyrender's ``OffscreenRenderer.delete`` terminates that display, killing the
-    other scenes' contexts (``EGL_BAD_DISPLAY``): while others live, only the closing scene's
-    context is destroyed."""
+    """Opens and closes the scenes' GL contexts. With EGL every context lives on one shared
+    display, and pyrender's ``OffscreenRenderer.delete`` terminates that display
+    (``eglTerminate``), killing every other context on it: other scenes' (``EGL_BAD_DISPLAY``)
+    and MuJoCo's, whose EGL module initialises the display once at import and then fails with
+    ``EGL_NOT_INITIALIZED`` (the pictures rendered after the cameras in a scenario). So a scene
+    destroys only its own context and leaves the display initialised."""
 
-    live = 0
-
-    @classmethod
-    def open(cls, width: int, height: int, matte: bool, antialias: bool):
+    @staticmethod
+    def open(width: int, height: int, matte: bool, antialias: bool):
         offscreen = pyrender.OffscreenRenderer(width, height)
         offscreen._renderer = _BodyRenderer(width, height, matte, antialias)  # no GL state yet
-        cls.live += 1
         return offscreen
 
-    @classmethod
-    def close(cls, offscreen: pyrender.OffscreenRenderer) -> None:
-        cls.live -= 1
+    @staticmethod
+    def close(offscreen: pyrender.OffscreenRenderer) -> None:
         platform = offscreen._platform
-        if cls.live == 0 or getattr(platform, "_egl_display", None) is None:
-            offscreen.delete()  # the last one, or a platform without a shared display
+        if getattr(platform, "_egl_display", None) is None:
+            offscreen.delete()  # a platform without a shared display (OSMesa)
             return
         from OpenGL.EGL import eglDestroyContext
 

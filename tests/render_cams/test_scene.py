@@ -125,3 +125,22 @@ def test_closing_one_scene_leaves_the_others_working(scene):
 def test_bad_intrinsics_raise(scene, K):
     with pytest.raises(SceneError):
         scene.render(np.eye(4), K, 64, 48)
+
+
+def test_mujoco_still_renders_after_the_last_scene_closes():
+    """Closing a scene must not terminate the shared EGL display: MuJoCo's renderer (the
+    scenario's pictures, after its cameras) initialises that display once, at import."""
+    from sim.humanoid import humanoid_for
+    from sim.render import render_frames
+
+    motion = generate("wave", duration_s=0.2, fps=30)
+    h = humanoid_for(motion)
+    render_frames(h.model, h.qpos, [0], 64, 64)  # MuJoCo's EGL display is initialised now
+    with BodyScene(h.body) as s:
+        s.update(h.motion, 0)
+        pose = np.eye(4)
+        pose[:3, 3] = [3.0, 0.0, 1.0]
+        pose[:3, :3] = [[0, 0, -1], [-1, 0, 0], [0, 1, 0]]  # OpenCV axes looking along -X
+        s.render(pose, pinhole_K(np.radians(60.0), 64, 64), 64, 64)
+    frame = render_frames(h.model, h.qpos, [0], 64, 64)[0]
+    assert frame.std() > 0
