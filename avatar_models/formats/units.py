@@ -44,7 +44,7 @@ def unit_scale(unit: str | float, path: object = None) -> float:
 def detect_unit(height_in_units: float, path: object = None) -> tuple[str, float]:
     """The named unit that makes ``height_in_units`` a human height, nearest to 1.7 m.
 
-    Raises :class:`MotionFormatError` (asking for ``unit=``) when no unit gives 1.0-2.5 m.
+    Raises :class:`MotionFormatError` (asking for ``--unit``) when no unit gives 1.0-2.5 m.
     """
     lo, hi = HUMAN_HEIGHT_M
     fits = [
@@ -55,7 +55,8 @@ def detect_unit(height_in_units: float, path: object = None) -> tuple[str, float
     if not fits:
         raise MotionFormatError(
             f"cannot guess the length unit: the skeleton is {height_in_units:.4g} units tall and "
-            f"no unit ({', '.join(UNITS)}) makes that {lo}-{hi} m; pass unit= explicitly",
+            f"no unit ({', '.join(UNITS)}) makes that {lo}-{hi} m; give the unit with --unit "
+            "(a name or metres per unit; from Python: unit=)",
             path,
         )
     _, name, scale = min(fits)

@@ -12,10 +12,19 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 from rich.progress import Progress
 from rich.table import Table
 
-from scripts.cli_common import JsonOpt, SeedOpt, console, emit_json, err_console, user_errors
+from scripts.cli_common import (
+    JsonOpt,
+    SeedOpt,
+    check_outputs,
+    console,
+    emit_json,
+    err_console,
+    user_errors,
+)
 
 
 def _table(results: dict) -> Table:
@@ -85,6 +94,17 @@ def register(app: typer.Typer) -> None:
         )
         from synthesis.report_plots import write_plots
 
+        for option, value, lo, hi in (
+            ("--subjects", subjects, 1, 50),
+            ("--takes", takes, 1, 20),
+            ("--duration", duration, 0.5, 600.0),
+            ("--heading", heading, 0.0, 180.0),
+            ("--db-headings", db_headings, 1, 36),
+            ("--max-per-class", 1 if max_per_class is None else max_per_class, 1, 100_000),
+        ):
+            if not lo <= value <= hi:  # also NaN
+                raise EvaluationError(f"{option} must be {lo:g}-{hi:g}, got {value}")
+        check_outputs(json_out=json_out, out=out)
         if method not in METHODS:
             raise EvaluationError(f"unknown method {method!r}; available: {', '.join(METHODS)}")
         if protocol not in PROTOCOLS:
@@ -131,10 +151,11 @@ def register(app: typer.Typer) -> None:
                 + "  (paper cross-subject: 16.5 -> 13.2 -> 11.4)"
             )
         for cls, reason in results["skipped"].items():
-            console.print(f"[yellow]skipped[/] {cls}: {reason}")
+            console.print(f"[yellow]skipped[/] {escape(cls)}: {escape(str(reason))}")
         for fail in results["failed_folds"]:
             console.print(
-                f"[yellow]fold failed[/] {fail['class']}/{fail['held_out']}: {fail['reason']}"
+                "[yellow]fold failed[/] "
+                + escape(f"{fail['class']}/{fail['held_out']}: {fail['reason']}")
             )
         results["plots"] = write_plots(results, out)
         emit_json(out / "eval.json", results)
