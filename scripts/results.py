@@ -127,15 +127,19 @@ def _check_owned(folder: Path, option: str, owner: str) -> None:
         return
     try:
         marker = json.loads((folder / OUTPUT_MARKER).read_text(encoding="utf-8"))
-        ours = set(marker["files"]) | {OUTPUT_MARKER} if marker["command"] == owner else set()
+        command, files = str(marker["command"]), set(marker["files"])
     except (OSError, ValueError, KeyError, TypeError):
-        ours = set()
-    foreign = sorted(present - ours)
+        command, files = None, set()
+    ours = files | {OUTPUT_MARKER} if command == owner else set()
+    # The user's own files first, hidden ones (a marker) last.
+    foreign = sorted(present - ours, key=lambda f: (Path(f).name.startswith("."), f))
     if foreign:
-        what = "holds files" if ours else "is not empty and not an earlier output"
+        whose = (
+            f" (it is an output of `avatarsim {command}`)" if command not in (None, owner) else ""
+        )
         raise AvatarsimError(
-            f"{option} {folder} {what} not written by `avatarsim {owner}` (e.g. "
-            f"{foreign[0]!r}); it would be replaced whole, so choose a new or empty folder"
+            f"{option} {folder} holds files not written by `avatarsim {owner}`{whose}, e.g. "
+            f"{foreign[0]!r}; it would be replaced whole, so choose a new or empty folder"
         )
 
 
