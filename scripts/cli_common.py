@@ -80,6 +80,16 @@ def user_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
             except Exception as exc:
                 if os.environ.get("AVATARSIM_DEBUG") == "1":
                     raise
+                if isinstance(exc, OSError) and exc.filename is not None:
+                    # The file system refused (a full disk, permissions changed meanwhile):
+                    # the user's environment, not a bug.
+                    err_console.print(
+                        f"[bold red]error:[/] {_one_line(exc.filename)}: "
+                        f"{_one_line(exc.strerror or exc)}",
+                        highlight=False,
+                        soft_wrap=True,
+                    )
+                    raise typer.Exit(2) from None
                 err_console.print(
                     f"[bold red]internal error:[/] {type(exc).__name__}: {_one_line(exc)} "
                     "(a bug in avatarsim; rerun with AVATARSIM_DEBUG=1 for the traceback)",

@@ -120,6 +120,27 @@ def _files_in(folder: Path) -> set[str]:
     return {str(p.relative_to(folder)) for p in folder.rglob("*") if not p.is_dir()}
 
 
+def _earlier_output(folder: Path, owner: str, present: set[str]) -> set[str]:
+    """The files of an output written before :data:`OUTPUT_MARKER` existed: ``track``'s
+    three files, or a run's folder (``results.json`` naming its outputs, whose folders hold
+    the rest). Empty when ``folder`` is not such an output."""
+    try:
+        if owner == "track":
+            names = {"tracking.csv", "tracking.json", "tracking.png"}
+            summary = json.loads((folder / "tracking.json").read_text(encoding="utf-8"))
+            return present if present <= names and "mode" in summary else set()
+        if owner == "run":
+            results = json.loads((folder / "results.json").read_text(encoding="utf-8"))
+            listed = {str(v) for v in results["outputs"].values()} | {"results.json"}
+            if not {"scenario", "versions"} <= set(results) or "junit.xml" not in listed:
+                return set()
+            tops = {Path(v).parts[0] for v in listed if len(Path(v).parts) > 1}
+            return {f for f in present if f in listed or Path(f).parts[0] in tops}
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        pass
+    return set()
+
+
 def _check_owned(folder: Path, option: str, owner: str) -> None:
     """``folder`` is empty or a previous output of ``owner`` with nothing else in it."""
     present = _files_in(folder)
@@ -129,7 +150,8 @@ def _check_owned(folder: Path, option: str, owner: str) -> None:
         marker = json.loads((folder / OUTPUT_MARKER).read_text(encoding="utf-8"))
         command, files = str(marker["command"]), set(marker["files"])
     except (OSError, ValueError, KeyError, TypeError):
-        command, files = None, set()
+        command, files = None, _earlier_output(folder, owner, present)
+        command = owner if files else None
     ours = files | {OUTPUT_MARKER} if command == owner else set()
     # The user's own files first, hidden ones (a marker) last.
     foreign = sorted(present - ours, key=lambda f: (Path(f).name.startswith("."), f))

@@ -47,6 +47,10 @@ def detect_unit(height_in_units: float, path: object = None) -> tuple[str, float
     Raises :class:`MotionFormatError` (asking for ``--unit``) when no unit gives 1.0-2.5 m.
     """
     lo, hi = HUMAN_HEIGHT_M
+    if not (np.isfinite(height_in_units) and height_in_units > 0):
+        raise MotionFormatError(
+            "the skeleton has no size (its bones are all zero length), so no unit fits", path
+        )
     fits = [
         (abs(np.log(height_in_units * s / TYPICAL_HEIGHT_M)), name, s)
         for name, s in UNITS.items()

@@ -308,7 +308,7 @@ def test_amc_without_asf_gives_advice_a_user_can_follow(tmp_path):
     result = runner.invoke(app, ["info", str(amc)])
     assert result.exit_code == 2
     assert "asf=" not in result.stderr.replace("asf=...", "")
-    assert "01_01.asf or 01.asf" in result.stderr and "same folder" in result.stderr
+    assert "same folder, named 01_01.asf or 01.asf" in result.stderr
 
 
 def test_options_that_would_be_ignored_exit_2(tmp_path):
@@ -327,7 +327,7 @@ def test_degenerate_skeleton_gives_one_line_and_no_numpy_warning(tmp_path):
     path = tmp_path / "zero.bvh"
     path.write_text(bvh(tmp_path, n=3).read_text().replace("OFFSET 0 90 0", "OFFSET 0 0 0"))
     path.write_text(path.read_text().replace("OFFSET 0 80 0", "OFFSET 0 0 0"))
-    bad(["check", str(path), "--out", str(tmp_path / "o")])
+    bad(["check", str(path), "--out", str(tmp_path / "o")], "no size")
 
 
 def test_convert_writes_files_with_the_umask_mode(tmp_path, clip):
@@ -385,3 +385,43 @@ def test_cmu_09_01_loses_its_t_pose_frame_and_its_residual_spike(tmp_path):
     rows = np.genfromtxt(out / "check.csv", delimiter=",", names=True)
     residual = [n for n in rows.dtype.names if n.startswith("residual")][0]
     assert rows[residual][:5].max() < 3.0  # was a 9.3 body-weight spike from the T-pose
+
+
+def test_an_output_from_before_the_marker_is_still_replaced(tmp_path):
+    from avatar_models.errors import AvatarsimError
+    from scripts.results import atomic_dir
+
+    out = tmp_path / "t"
+    out.mkdir()
+    (out / "tracking.json").write_text('{"mode": "plain"}')
+    (out / "tracking.csv").write_text("a\n")
+    with atomic_dir(out, "track") as partial:
+        (partial / "tracking.json").write_text('{"mode": "search"}')
+    assert sorted(p.name for p in out.iterdir()) == [".avatarsim-output.json", "tracking.json"]
+    run = tmp_path / "r"
+    (run / "physics").mkdir(parents=True)
+    (run / "physics" / "check.csv").write_text("x")
+    outputs = {"results_json": "results.json", "junit_xml": "junit.xml", "p": "physics/check.csv"}
+    (run / "results.json").write_text(
+        json.dumps({"scenario": "s", "versions": {}, "outputs": outputs})
+    )
+    (run / "junit.xml").write_text("<x/>")
+    (run / "mine.txt").write_text("mine")
+    with pytest.raises(AvatarsimError, match="mine.txt"), atomic_dir(run, "run"):
+        pass
+    (run / "mine.txt").unlink()
+    with atomic_dir(run, "run") as partial:
+        (partial / "results.json").write_text("{}")
+    assert sorted(p.name for p in run.iterdir()) == [".avatarsim-output.json", "results.json"]
+
+
+def test_a_file_system_refusal_mid_run_exits_2_not_3(tmp_path, monkeypatch):
+    import errno
+
+    import avatar_models.formats as formats
+
+    def full(motion, path, **options):
+        raise OSError(errno.ENOSPC, "No space left on device", str(path))
+
+    monkeypatch.setattr(formats, "save_motion", full)
+    bad(["convert", "builtin:walk", str(tmp_path / "x.bvh")], "x.bvh", "No space left")
