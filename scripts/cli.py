@@ -96,9 +96,12 @@ def convert(
 
     if fps is not None:
         check_fps(fps, "--fps")
-    if dst.suffix.lower() not in WRITABLE:
-        raise AvatarsimError(f"cannot write {dst.suffix!r}; writable: {', '.join(WRITABLE)}")
     check_outputs(json_out=json_out, files={"OUT": dst})
+    if dst.suffix.lower() not in WRITABLE:
+        raise AvatarsimError(
+            f"OUT {dst}: cannot write {dst.suffix or 'a file without suffix'}; "
+            f"writable: {', '.join(WRITABLE)}"
+        )
     m = load_motion_arg(src, unit, seed)
     if fps is not None:
         m = m.resample(fps)

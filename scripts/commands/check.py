@@ -48,11 +48,11 @@ def register(app: typer.Typer) -> None:
         json_out: JsonOpt = None,
     ) -> None:
         """Physics plausibility of a motion on the MuJoCo humanoid. Exit 1 if a check fails."""
+        check_outputs(json_out=json_out, out=out, export=export)
         from sim.plausibility import body_and_motion, check_motion
         from sim.report import summary_rows, write_outputs
         from sim.thresholds import CheckConfig
 
-        check_outputs(json_out=json_out, out=out, export=export)
         cfg = CheckConfig.from_toml(config) if config is not None else CheckConfig()
         m = load_motion_arg(motion, unit, seed, min_frames=MIN_FRAMES)
         body, m = body_and_motion(m, None)

@@ -44,7 +44,9 @@ def _table(results: dict) -> Table:
         ]
         corr = f"{s['hand_corr']['left']:.3f}/{s['hand_corr']['right']:.3f}"
         fps = f"{s['frames_per_s']:.0f} ({s['baseline_frames_per_s']:.0f})"
-        table.add_row(name, str(s["trials"]), *cells, corr, fps, end_section=name == "overall")
+        table.add_row(
+            escape(name), str(s["trials"]), *cells, corr, fps, end_section=name == "overall"
+        )
     return table
 
 
@@ -128,7 +130,7 @@ def register(app: typer.Typer) -> None:
             task = bar.add_task(f"{method} {protocol}", total=None)
 
             def progress(done: int, total: int, label: str) -> None:
-                bar.update(task, completed=done, total=total, description=label)
+                bar.update(task, completed=done, total=total, description=escape(label))
 
             results = run_protocol(
                 trials,

@@ -72,11 +72,6 @@ def register(app: typer.Typer) -> None:
         """Physics tracking of a motion by the MuJoCo humanoid. Exit 1 if it falls or does not
         reach the requested time."""
         from avatar_models.errors import MotionValueError
-        from scripts.results import atomic_dir
-        from sim.plausibility import body_and_motion
-        from sim.sampling import SearchSettings, timed_tracking
-        from sim.tracking import looped
-        from sim.tracking_report import write_outputs
 
         if seconds is not None and not 0 < seconds <= MAX_TRACK_S:
             raise MotionValueError(
@@ -85,6 +80,12 @@ def register(app: typer.Typer) -> None:
         if not (1 <= samples <= MAX_SEARCH and 1 <= beam <= MAX_SEARCH):
             raise MotionValueError(f"--samples and --beam must be 1-{MAX_SEARCH}")
         check_outputs(json_out=json_out, out=out, out_owner="track", export=export)
+        from scripts.results import atomic_dir
+        from sim.plausibility import body_and_motion
+        from sim.sampling import SearchSettings, timed_tracking
+        from sim.tracking import looped
+        from sim.tracking_report import write_outputs
+
         m = load_motion_arg(motion, unit, seed, duration_s=seconds or 10.0, min_frames=MIN_FRAMES)
         if seconds is None and m.duration_s > MAX_TRACK_S:
             raise MotionValueError(
