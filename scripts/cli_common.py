@@ -51,6 +51,9 @@ def _check_common(kwargs: dict[str, Any]) -> None:
     seed = kwargs.get("seed")
     if isinstance(seed, int) and seed < 0:
         raise AvatarsimError(f"--seed must be 0 or more (numpy's generators), got {seed}")
+    motion = kwargs.get("motion", kwargs.get("src"))
+    if kwargs.get("unit") is not None and str(motion).startswith(BUILTIN_PREFIX):
+        raise AvatarsimError(f"--unit applies to motion files; {motion} is in metres already")
 
 
 def user_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
