@@ -185,9 +185,15 @@ def atomic_dir(final_dir: Path, owner: str) -> Iterator[Path]:
         if final_dir.exists():
             _check_owned(final_dir, "--out", owner)  # again: it may have changed meanwhile
             old = Path(tempfile.mkdtemp(dir=final_dir.parent, prefix=f".{final_dir.name}.old-"))
-            os.replace(final_dir, old / "x")
-            os.replace(out_dir, final_dir)
-            shutil.rmtree(old, ignore_errors=True)
+            try:
+                os.replace(final_dir, old / "x")
+                try:
+                    os.replace(out_dir, final_dir)
+                except BaseException:
+                    os.replace(old / "x", final_dir)  # the earlier output stays as it was
+                    raise
+            finally:
+                shutil.rmtree(old, ignore_errors=True)
         else:
             os.replace(out_dir, final_dir)
     except BaseException:
