@@ -425,3 +425,26 @@ def test_a_file_system_refusal_mid_run_exits_2_not_3(tmp_path, monkeypatch):
 
     monkeypatch.setattr(formats, "save_motion", full)
     bad(["convert", "builtin:walk", str(tmp_path / "x.bvh")], "x.bvh", "No space left")
+
+
+def test_numpy_warnings_never_come_before_the_error_line(tmp_path, monkeypatch):
+    import avatar_models.formats as formats
+    from avatar_models.errors import MotionFormatError
+
+    def noisy(path, **options):
+        with np.errstate(divide="warn"):
+            np.log(np.zeros(1))  # RuntimeWarning: divide by zero
+        raise MotionFormatError("broken", path)
+
+    monkeypatch.setattr(formats, "load_motion", noisy)
+    bad(["info", str(tmp_path / "a.bvh")], "broken")  # one line: the warning is dropped
+
+    def noisy_ok(path, **options):
+        with np.errstate(divide="warn"):
+            np.log(np.zeros(1))
+        return generate("wave", duration_s=0.2)
+
+    monkeypatch.setattr(formats, "load_motion", noisy_ok)
+    result = runner.invoke(app, ["info", str(tmp_path / "a.bvh")])
+    assert result.exit_code == 0
+    assert result.stderr.count("warning: RuntimeWarning: divide by zero") == 1
