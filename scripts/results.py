@@ -116,8 +116,24 @@ def check_output_dir(path: Path | None, option: str, owner: str | None = None) -
         _check_owned(path, option, owner)
 
 
+# More files than any output of ours holds: a folder with more is nobody's output of ours,
+# and is not walked further (``--out /`` answers at once).
+_MAX_FILES = 10_000
+
+
 def _files_in(folder: Path) -> set[str]:
-    return {str(p.relative_to(folder)) for p in folder.rglob("*") if not p.is_dir()}
+    """Entries below ``folder`` (relative paths), at most :data:`_MAX_FILES` + 1 of them:
+    files, links to folders and empty folders (none of which an output of ours has)."""
+    found: set[str] = set()
+    for root, dirs, files in os.walk(folder):
+        here = Path(root)
+        links = [d for d in dirs if (here / d).is_symlink()]
+        empty = [] if files or dirs or here == Path(folder) else [""]
+        for name in [*files, *links, *empty]:
+            found.add(str((here / name).relative_to(folder)))
+            if len(found) > _MAX_FILES:
+                return found
+    return found
 
 
 def _earlier_output(folder: Path, owner: str, present: set[str]) -> set[str]:

@@ -410,6 +410,14 @@ def test_an_output_from_before_the_marker_is_still_replaced(tmp_path):
     with pytest.raises(AvatarsimError, match="mine.txt"), atomic_dir(run, "run"):
         pass
     (run / "mine.txt").unlink()
+    (run / "empty").mkdir()  # a user's empty folder or link to one is no file of ours either
+    with pytest.raises(AvatarsimError, match="empty"), atomic_dir(run, "run"):
+        pass
+    (run / "empty").rmdir()
+    (run / "link").symlink_to(tmp_path)
+    with pytest.raises(AvatarsimError, match="link"), atomic_dir(run, "run"):
+        pass
+    (run / "link").unlink()
     with atomic_dir(run, "run") as partial:
         (partial / "results.json").write_text("{}")
     assert sorted(p.name for p in run.iterdir()) == [".avatarsim-output.json", "results.json"]
