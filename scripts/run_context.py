@@ -6,28 +6,26 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import mujoco
-import numpy as np
 from rich.console import Console
 
-from avatar_models.body import BodyDescription
 from avatar_models.motion import Motion
 from scripts.results import CheckResult
 from scripts.scenario import Scenario
+from sim.humanoid import Humanoid
 
 
 @dataclass
 class RunContext:
-    """Filled stage by stage. ``metrics`` are thresholded by ``[thresholds]``; ``checks`` hold
-    rows a stage judged itself (e.g. physics checks with their own thresholds)."""
+    """Filled stage by stage. ``motion`` is the ground truth; ``humanoid`` its body, built
+    once (stage ``body``) and used by every later stage. ``metrics`` are thresholded by
+    ``[thresholds]``; ``checks`` hold rows a stage judged itself (e.g. physics checks with
+    their own thresholds)."""
 
     scenario: Scenario
     out_dir: Path
     console: Console
     motion: Motion | None = None
-    body: BodyDescription | None = None
-    model: mujoco.MjModel | None = None
-    qpos: np.ndarray | None = None
+    humanoid: Humanoid | None = None
     artifacts: dict[str, Any] = field(default_factory=dict)
     metrics: dict[str, float] = field(default_factory=dict)
     checks: list[CheckResult] = field(default_factory=list)

@@ -11,20 +11,19 @@ import json
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
-import mujoco
 import numpy as np
 
-from avatar_models.body import BodyDescription
+from sim.humanoid import Humanoid
 
 MAX_KEYS = 2000  # keyframes in replay.xml; longer clips are subsampled evenly
 
 
-def export_replay(body: BodyDescription, qpos: np.ndarray, fps: float, out_dir: Path) -> list[Path]:
-    """Write the files above into ``out_dir`` for ``qpos (T, nq)``; returns their paths."""
+def export_replay(humanoid: Humanoid, qpos: np.ndarray, fps: float, out_dir: Path) -> list[Path]:
+    """Write the files above into ``out_dir`` for ``qpos (T, nq)`` of ``humanoid`` (its
+    motion's, or a simulation's of it); returns their paths."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    xml = body.to_mjcf()
-    model = mujoco.MjModel.from_xml_string(xml)
+    xml, model = humanoid.mjcf, humanoid.model
     frames = np.unique(np.linspace(0, len(qpos) - 1, min(len(qpos), MAX_KEYS)).round().astype(int))
     root = ET.fromstring(xml)
     keyframe = ET.SubElement(root, "keyframe")

@@ -1,8 +1,6 @@
-"""``check_motion``: replay a motion on the humanoid and run every physics check on it.
-
-The entry point for the CLI, scenarios and tests. A motion on a skeleton the body cannot be
-built from (a foreign rig whose rest pose does not stand, e.g. Bandai) needs retargeting onto
-a humanoid first; :func:`body_and_motion` is the one place that decides this.
+"""``check_humanoid`` / ``check_motion``: replay a motion on the humanoid and run every
+physics check on it. The humanoid comes from :func:`sim.humanoid.humanoid_for`, the one place
+that decides whether a rig is retargeted.
 """
 
 from __future__ import annotations
@@ -15,16 +13,12 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from avatar_models.body import BodyDescription, BodyError, build_body
-from avatar_models.errors import AvatarsimError, MotionValueError
+from avatar_models.body import BodyDescription
+from avatar_models.errors import MotionValueError
 from avatar_models.motion import Motion
 from sim.checks import ALL_CHECKS, BodyReplay, Check, CheckResult
+from sim.humanoid import Humanoid, humanoid_for
 from sim.thresholds import THRESHOLD_KEYS, CheckConfig
-
-
-class RetargetingNeeded(AvatarsimError):
-    """The motion's rig has no humanoid body of its own; it must be retargeted first."""
-
 
 CONTRACT_KEYS = (
     "penetration_cm_p95",
@@ -34,45 +28,6 @@ CONTRACT_KEYS = (
     "self_collision_frac",
     "residual_force_bw_p95",
 )
-
-
-def body_and_motion(
-    motion: Motion,
-    body: BodyDescription | None,
-    retarget_foreign: bool = True,
-    level_feet: bool = False,
-) -> tuple[BodyDescription, Motion]:
-    """The body to replay ``motion`` on and the motion on that body's skeleton.
-
-    A motion on a rig whose rest pose does not stand (e.g. Bandai), or on another rig than
-    ``body``'s, is retargeted onto the humanoid by body17 IK (:func:`sim.retarget.retarget`);
-    its mean residual is recorded in the returned motion's ``meta["retarget_residual_cm"]``.
-    ``level_feet`` is passed on to the retargeting (stance feet flat, for physics tracking).
-
-    Raises:
-        RetargetingNeeded: such a motion with ``retarget_foreign=False``.
-        BodyError: the skeleton is no known rig.
-    """
-    reason = None
-    if body is None:
-        try:
-            body = build_body(motion.skeleton)
-        except BodyError as exc:
-            if "not upright" not in str(exc):
-                raise
-            reason = str(exc)
-    elif not motion.skeleton.same_topology(body.skeleton):
-        reason = f"motion rig {motion.skeleton.name!r} is not the body's rig {body.skeleton.name!r}"
-    if reason is None:
-        return body, motion
-    if not retarget_foreign:
-        raise RetargetingNeeded(f"{reason}; retarget the motion onto a humanoid rig first")
-    from sim.retarget import retarget  # IK (mink) is only loaded when needed
-
-    result = retarget(motion, body, level_feet=level_feet)
-    meta = {**result.motion.meta, "retarget_residual_cm": float(np.mean(result.residual_cm))}
-    out = result.motion.replace(meta=meta)
-    return (body if body is not None else build_body(out.skeleton)), out
 
 
 @dataclass(frozen=True, eq=False)
@@ -166,23 +121,40 @@ def check_qpos(
     return PlausibilityReport(tuple(c(replay, config) for c in checks), config, fps, meta)
 
 
+def check_humanoid(
+    humanoid: Humanoid,
+    config: CheckConfig | None = None,
+    checks: Sequence[Check] = ALL_CHECKS,
+) -> PlausibilityReport:
+    """Run ``checks`` on the motion of ``humanoid`` (:func:`sim.humanoid.humanoid_for`);
+    the report's meta holds the retargeting summary and the motion's scalar meta."""
+    h = humanoid
+    report = check_qpos(h.body, h.qpos, h.motion.fps, config, checks, model=h.model)
+    scalars = {k: v for k, v in h.motion.meta.items() if isinstance(v, str | int | float | bool)}
+    report.meta.update(scalars | h.summary())
+    return report
+
+
 def check_motion(
     motion: Motion,
     body: BodyDescription | None = None,
     config: CheckConfig | None = None,
     checks: Sequence[Check] = ALL_CHECKS,
 ) -> PlausibilityReport:
-    """Replay ``motion`` on ``body`` (built from the motion's skeleton when ``None``) and
-    run ``checks`` with ``config`` (defaults: :class:`CheckConfig`).
+    """Replay ``motion`` on ``body`` (a motion on that body's own skeleton), or on the
+    humanoid :func:`sim.humanoid.humanoid_for` gives when ``None``, and run ``checks`` with
+    ``config`` (defaults: :class:`CheckConfig`).
 
     Raises:
-        MotionValueError: non-finite motion.
-        RetargetingNeeded, BodyError: see :func:`body_and_motion`.
+        MotionValueError: non-finite motion; a motion not on ``body``'s skeleton.
+        BodyError: see :func:`sim.humanoid.humanoid_for`.
     """
     if not (np.all(np.isfinite(motion.root_pos)) and np.all(np.isfinite(motion.local_rot))):
         raise MotionValueError("motion has NaN/inf values")
-    body, motion = body_and_motion(motion, body)
-    report = check_qpos(body, body.qpos_from_motion(motion), motion.fps, config, checks)
-    scalars = {k: v for k, v in motion.meta.items() if isinstance(v, str | int | float | bool)}
-    report.meta.update(scalars)
-    return report
+    if body is None:
+        return check_humanoid(humanoid_for(motion), config, checks)
+    if not motion.skeleton.same_topology(body.skeleton):
+        raise MotionValueError(
+            f"motion rig {motion.skeleton.name!r} is not the body's rig {body.skeleton.name!r}"
+        )
+    return check_qpos(body, body.qpos_from_motion(motion), motion.fps, config, checks)

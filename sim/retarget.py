@@ -46,13 +46,22 @@ from scipy.spatial.transform import Rotation
 
 from avatar_models import quat
 from avatar_models.body import BodyDescription, build_body
+from avatar_models.body.anatomy import classify
 from avatar_models.body.ik import HumanoidIK, IKSettings, humanoid_model, motion_from_qpos
 from avatar_models.body17 import BODY17, INDEX
 from avatar_models.errors import MotionValueError, RigError
 from avatar_models.measure import standing_height
 from avatar_models.motion import Motion
 from avatar_models.rigs import body17_positions, load_rig
-from sim.soles import box_corners, corner_positions, sole_boxes, subtree_mask
+from sim.soles import (
+    box_corners,
+    corner_positions,
+    foot_bodies,
+    sole_boxes,
+    subtree_mask,
+    thigh_bodies,
+    toe_bodies,
+)
 
 TEMPLATE_RIG = "avatar"
 FOOT_SITES = (("l_ankle", "l_foot"), ("r_ankle", "r_foot"))
@@ -131,7 +140,7 @@ def fitted_body(motion: Motion, mass_kg: float = 75.0) -> BodyDescription:
     source = body17_positions(motion)
     ours, theirs = span_lengths(rest[None]), span_lengths(source)
     scale = {kind: theirs[kind] / ours[kind] for kind in SEGMENT_SPANS}
-    rig_kinds = build_body(sk).anatomy.bone_kind
+    rig_kinds = classify(sk, rig).bone_kind
     # Shoulders and hips: place each where the source has it relative to the neck or the
     # pelvis (the avatar's clavicles are bones of kind "torso", so no length factor alone
     # can set shoulder width and height). Offsets are set before the kind factors apply,
@@ -147,14 +156,28 @@ def fitted_body(motion: Motion, mass_kg: float = 75.0) -> BodyDescription:
     return build_body(sk.with_offsets(offsets), mass_kg=mass_kg, segment_scale=scale)
 
 
+def humanoid_body(motion: Motion, mass_kg: float = 75.0) -> BodyDescription:
+    """The body a foreign-rig ``motion`` is retargeted onto: the one that the skeleton of
+    :func:`fitted_body` builds (``build_body(result.motion.skeleton)``, what a caller
+    simulates). fitted_body's own segment scaling also sizes geoms (toe box 1 cm shorter,
+    head, masses), and a reference made for other feet than the simulated ones puts the toes
+    into the floor."""
+    return build_body(fitted_body(motion).skeleton, mass_kg=mass_kg)
+
+
 def retarget(
     motion: Motion,
     body: BodyDescription | None = None,
     settings: IKSettings | None = None,
     level_feet: bool = False,
+    scale_targets: bool | None = None,
+    model: mujoco.MjModel | None = None,
 ) -> Retargeted:
     """Retarget ``motion`` (any rig with a body17 map) onto ``body`` (default:
-    :func:`fitted_body`). Joint limits of the body hold in the result. ``level_feet`` puts
+    :func:`humanoid_body`). ``scale_targets`` (default: whether a body was given) scales
+    the targets to the body's standing height; a body made by :func:`humanoid_body` for this
+    motion is already its size. ``model`` is the body's compiled MJCF when the caller has
+    it (it is only read). Joint limits of the body hold in the result. ``level_feet`` puts
     stance feet flat on the floor and clears swinging ones (module docstring), for physics
     tracking; off by default, since it trades fidelity for it (Bandai walk normal_001: mean
     body17 residual 0.03 -> 0.75 cm, p95 2.4 cm), so the physics checks judge the source's own
@@ -168,16 +191,13 @@ def retarget(
         targets = body17_positions(motion)
     except RigError as exc:
         raise MotionValueError(f"cannot retarget: {exc}") from exc
-    fitted = body is None
-    if fitted:
-        # The body that the result's skeleton builds (build_body(out.motion.skeleton), what
-        # a caller simulates): fitted_body's own segment scaling also sizes geoms (toe box
-        # 1 cm shorter, head, masses), and a reference made for other feet than the
-        # simulated ones puts the toes into the floor.
-        body = build_body(fitted_body(motion).skeleton)
-    else:
+    if scale_targets is None:
+        scale_targets = body is not None
+    if body is None:
+        body = humanoid_body(motion)
+    if scale_targets:
         targets = targets * (standing_height(body.skeleton) / standing_height(motion))
-    model = humanoid_model(body)
+    model = humanoid_model(body) if model is None else model
     stance = stance_feet(targets, motion.fps)
     if level_feet:  # without the floor offset below, flat feet would float (Bandai: 6 cm)
         targets = match_foot_pitch(model, targets, stance)
@@ -245,9 +265,10 @@ def lift_toes(model, qpos: np.ndarray, steps: int = 40) -> np.ndarray:
     out = qpos.copy()
     data = mujoco.MjData(model)
     toes = []
+    toe_ids = [model.body(name).id for name in toe_bodies(model)]
     for j in range(model.njnt):
         body = model.jnt_bodyid[j]
-        if "Toe" in model.body(body).name and model.joint(j).name.endswith(":ry"):
+        if body in toe_ids and model.joint(j).name.endswith(":ry"):
             geoms = sole_boxes(model, (model.body(body).name,))
             if geoms.size:
                 toes.append((geoms[:1], int(model.jnt_qposadr[j]), model.jnt_range[j]))
@@ -305,8 +326,7 @@ def clear_swing_feet(
     out = qpos.copy()
     data = mujoco.MjData(model)
     legs, boxes = [], []
-    for side in "LR":
-        foot, thigh = f"Bip01 {side} Foot", f"Bip01 {side} Thigh"
+    for foot, thigh in zip(foot_bodies(model), thigh_bodies(model), strict=True):
         chain = subtree_mask(model, (thigh,)) & ~subtree_mask(model, (foot,))
         chain[model.body(foot).id] = True  # thigh to foot, toes left alone
         legs.append(np.flatnonzero(chain[model.dof_bodyid]))

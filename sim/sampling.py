@@ -33,12 +33,9 @@ import mujoco
 import numpy as np
 from tqdm import tqdm
 
-from avatar_models.body import BodyDescription
-from avatar_models.body.ik import humanoid_model
 from avatar_models.body17 import BODY17
-from sim.soles import subtree_mask
+from sim.soles import subtree_mask, thigh_bodies
 from sim.tracking import (
-    THIGHS,
     Progress,
     Reference,
     Tracker,
@@ -180,7 +177,7 @@ def search_track(
     m, d = tracker.model, tracker.data
     ref = tracker.reference(qpos_ref, fps)
     rng = np.random.default_rng(search.seed)
-    leg = subtree_mask(m, THIGHS)[m.jnt_bodyid[m.actuator_trnid[:, 0]]]
+    leg = subtree_mask(m, thigh_bodies(m))[m.jnt_bodyid[m.actuator_trnid[:, 0]]]
     sigma = np.where(leg, search.sigma_leg_rad, search.sigma_rad)
     window = max(1, int(round(search.window_s / m.opt.timestep)))
     lookahead = int(round(search.lookahead_s / m.opt.timestep))
@@ -263,20 +260,19 @@ def replay(
 
 
 def timed_tracking(
-    body: BodyDescription,
+    model: mujoco.MjModel,
     qpos_ref: np.ndarray,
     fps: float,
     search: SearchSettings | None,
     progress_bar: bool = False,
 ) -> tuple[TrackingResult, dict]:
-    """Track ``qpos_ref (T, nq)`` on a fresh humanoid of ``body``: by :func:`search_track`
-    with ``search``, or by the plain controller when it is ``None``. Returns the result and
-    its summary (:meth:`TrackingResult.summary`) with the mode, the search's settings and
+    """Track ``qpos_ref (T, nq)`` on (a copy of) ``model``: by :func:`search_track` with
+    ``search``, or by the plain controller when it is ``None``. Returns the result and its
+    summary (:meth:`TrackingResult.summary`) with the mode, the search's settings and
     simulated seconds, the wall time and the speed next to real time, and the outcome:
     ``requested_s`` (the reference's length), ``completed`` (tracked to its end without a
     fall) and ``failure`` (``None``, ``"fell"``, or ``"search exhausted"`` when the search
     gave up before the end: every sample fell within its look-ahead)."""
-    model = humanoid_model(body)
     start = time.perf_counter()
     reached = True
     if search is None:

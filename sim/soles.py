@@ -1,5 +1,9 @@
 """The soles of the humanoid's feet: its box geoms below each foot body, and their corners.
 
+Bodies are found through the body17 sites the MJCF places on them (the ankle site sits on the
+foot body, the hip site on the thigh), never by a rig's bone names, so every rig's humanoid
+(avatar, CMU, a built-in subject) works alike.
+
 Shapes: ``G`` sole boxes, 8 corners each.
 """
 
@@ -8,8 +12,31 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-FEET = ("Bip01 L Foot", "Bip01 R Foot")
+ANKLE_SITES = ("l_ankle", "r_ankle")
+HIP_SITES = ("l_hip", "r_hip")
+BALL_SITES = ("l_foot", "r_foot")
 _SIGNS = np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1], indexing="ij")).reshape(3, -1).T
+
+
+def site_bodies(model: mujoco.MjModel, sites: tuple[str, ...]) -> tuple[str, ...]:
+    """Names of the bodies that carry the body17 ``sites``, in their order."""
+    return tuple(model.body(model.site_bodyid[model.site(name).id]).name for name in sites)
+
+
+def foot_bodies(model: mujoco.MjModel) -> tuple[str, str]:
+    """The left and right foot bodies (those of the ankle sites)."""
+    return site_bodies(model, ANKLE_SITES)
+
+
+def toe_bodies(model: mujoco.MjModel) -> tuple[str, ...]:
+    """The toe bodies (those of the ball-of-foot sites), where a rig has them below the foot."""
+    feet = foot_bodies(model)
+    return tuple(b for b in site_bodies(model, BALL_SITES) if b not in feet)
+
+
+def thigh_bodies(model: mujoco.MjModel) -> tuple[str, str]:
+    """The left and right thigh bodies (those of the hip sites)."""
+    return site_bodies(model, HIP_SITES)
 
 
 def subtree_mask(model: mujoco.MjModel, names: tuple[str, ...]) -> np.ndarray:
@@ -20,9 +47,10 @@ def subtree_mask(model: mujoco.MjModel, names: tuple[str, ...]) -> np.ndarray:
     return mask
 
 
-def sole_boxes(model: mujoco.MjModel, feet: tuple[str, ...] = FEET) -> np.ndarray:
-    """``(G,)`` ids of the box geoms on the bodies ``feet`` and below them (the toes)."""
-    below = subtree_mask(model, feet)
+def sole_boxes(model: mujoco.MjModel, feet: tuple[str, ...] | None = None) -> np.ndarray:
+    """``(G,)`` ids of the box geoms on the bodies ``feet`` (default: both
+    :func:`foot_bodies`) and below them (the toes)."""
+    below = subtree_mask(model, foot_bodies(model) if feet is None else feet)
     return np.flatnonzero(below[model.geom_bodyid] & (model.geom_type == mujoco.mjtGeom.mjGEOM_BOX))
 
 

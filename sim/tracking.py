@@ -62,21 +62,28 @@ Luo et al. 2023, "Perpetual humanoid control"), has failed as well and counts as
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 from qpsolvers import solve_qp
 from scipy.ndimage import gaussian_filter1d
+from scipy.spatial.distance import cdist
 
 from avatar_models.body17 import BODY17
 from avatar_models.errors import MotionValueError
-from sim.soles import FEET, box_corners, corner_positions, sole_boxes
+from sim.soles import (
+    ANKLE_SITES,
+    box_corners,
+    corner_positions,
+    foot_bodies,
+    sole_boxes,
+    thigh_bodies,
+)
 
 ROOT_DOF = 6
 QP_SOLVER = "daqp"
-THIGHS = ("Bip01 L Thigh", "Bip01 R Thigh")
-ANKLE_SITES = ("l_ankle", "r_ankle")
 GRAVITY = 9.81
 
 
@@ -233,7 +240,7 @@ def looped(qpos: np.ndarray, fps: float, duration_s: float, min_cycle_s: float =
         raise MotionValueError(f"clip too short to loop: {n} frames at {fps} fps")
     hinge = qpos[:, 7:]
     feature = np.hstack([hinge, np.gradient(hinge, axis=0) * 3.0, qpos[:, 2:3] * 10.0])
-    dist = np.linalg.norm(feature[:, None] - feature[None], axis=-1)
+    dist = cdist(feature, feature)  # (T, T); a broadcast difference would be (T, T, F)
     gap = np.arange(n)[None] - np.arange(n)[:, None]
     dist[gap < min_cycle_s * fps] = np.inf
     i, j = np.unravel_index(np.argmin(dist), dist.shape)
@@ -322,7 +329,8 @@ class Tracker:
         if model.nu == 0 or np.any(model.jnt_type[model.actuator_trnid[:, 0]] == 0):
             raise MotionValueError("tracking needs hinge actuators and no actuator on the root")
         self.settings = s = settings or TrackingSettings()
-        self.model = model
+        # A copy: the caller's model (e.g. a Humanoid's, shared by every stage) stays as is.
+        self.model = model = copy.copy(model)
         # The tracking copy's actuators become motors (ctrl = torque, no clamp), and geoms
         # report floor contacts within the margin without acting on them (gap = margin).
         model.actuator_gainprm[:] = 0.0
@@ -345,8 +353,10 @@ class Tracker:
         self.ankles = np.array(
             [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, n) for n in ANKLE_SITES]
         )
-        self.feet = [model.body(name).id for name in FEET]
-        hips = [np.flatnonzero(model.jnt_bodyid == model.body(name).id) for name in THIGHS]
+        self.feet = [model.body(name).id for name in foot_bodies(model)]
+        hips = [
+            np.flatnonzero(model.jnt_bodyid == model.body(name).id) for name in thigh_bodies(model)
+        ]
         self.hip_dof = [model.jnt_dofadr[j] for j in hips]
         self.hip_qadr = [model.jnt_qposadr[j] for j in hips]
         # Sole boxes: the box geoms of the feet and the bodies below them (toes), with their
@@ -714,6 +724,6 @@ def track(
     fps: float,
     settings: TrackingSettings | None = None,
 ) -> TrackingResult:
-    """Track ``qpos_ref (T, nq)`` at ``fps`` with a fresh :class:`Tracker` on ``model``
-    (which it modifies: build one model per tracker)."""
+    """Track ``qpos_ref (T, nq)`` at ``fps`` with a fresh :class:`Tracker` on a copy of
+    ``model``."""
     return Tracker(model, settings).run(qpos_ref, fps)

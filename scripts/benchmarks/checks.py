@@ -9,12 +9,10 @@ residual force (``mj_inverse`` per frame). Baseline: 90 frames/s, so the ratio r
 
 from __future__ import annotations
 
-import mujoco
-
-from avatar_models.body import build_body
 from avatar_models.generator import generate
 from scripts.benchmarks import BenchRow, best_of
 from sim.checks import ALL_CHECKS
+from sim.humanoid import humanoid_for
 from sim.plausibility import check_qpos
 from sim.replay import replay_kinematic
 
@@ -23,9 +21,8 @@ REAL_TIME_HZ = 90.0
 
 def run(quick: bool = False) -> list[BenchRow]:
     motion = generate("walk", duration_s=10.0 if quick else 60.0, fps=REAL_TIME_HZ)
-    body = build_body(motion.skeleton)
-    model = mujoco.MjModel.from_xml_string(body.to_mjcf())
-    qpos = body.qpos_from_motion(motion)
+    h = humanoid_for(motion)
+    body, model, qpos = h.body, h.model, h.qpos
     n = len(qpos)
     kinematic = [c for c in ALL_CHECKS if c.name != "residual_force"]
     cases = {

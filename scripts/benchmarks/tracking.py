@@ -6,7 +6,8 @@ Rows: simulated seconds per wall second tracking the built-in walk with the plai
 time) and with the sampling search (``sim.sampling``: 48 samples of every 0.2 s window, each
 judged 0.2 s later), next to real time (1x); the share of 10 s built-in walks (seeds 0-3)
 tracked without a fall by the search, next to the plain controller's share (not in
-``--quick``); retargeting frames/s (``sim.retarget``: body17 IK with mink) on a CMU clip from
+``--quick``); retargeting frames/s (``sim.retarget``: body17 IK with mink, stance feet levelled for
+tracking, as :func:`sim.humanoid.humanoid_for` does for a foreign rig) on a Bandai walk from
 ``../shared/mocap`` (the built-in walk when that folder is absent), next to the clip's own
 frame rate.
 """
@@ -16,27 +17,25 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from avatar_models.body import build_body
-from avatar_models.body.ik import humanoid_model
 from avatar_models.formats import load_motion
 from avatar_models.generator import generate
 from scripts.benchmarks import BenchRow, best_of
+from sim.humanoid import humanoid_for
 from sim.retarget import retarget
 from sim.sampling import search_track
 from sim.tracking import track
 
 MOCAP_DIR = Path(__file__).resolve().parents[2].parent / "shared" / "mocap"
-CMU_CLIP = "cmu/16_35.bvh"
+RETARGET_CLIP = "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh"
 
 
 def _speed_rows(quick: bool) -> list[BenchRow]:
     seconds = 1.0 if quick else 2.0  # the plain controller stays upright 2 s (tests)
     walk = generate("walk", duration_s=seconds, fps=30.0)
-    body = build_body(walk.skeleton)
-    qpos = body.qpos_from_motion(walk)
+    h = humanoid_for(walk)
     repeats = 1 if quick else 3
-    plain = best_of(lambda: track(humanoid_model(body), qpos, walk.fps), repeats)
-    search = best_of(lambda: search_track(humanoid_model(body), qpos, walk.fps), 1)
+    plain = best_of(lambda: track(h.model, h.qpos, walk.fps), repeats)
+    search = best_of(lambda: search_track(h.model, h.qpos, walk.fps), 1)
     note = f"{seconds:.0f} s walk"
     return [
         BenchRow("tracking[walk, plain]", "x real time", seconds / plain, 1.0, "real time", note),
@@ -49,10 +48,9 @@ def _upright_row() -> BenchRow:
     upright = {"plain": 0, "search": 0}
     for seed in seeds:
         walk = generate("walk", duration_s=seconds, fps=30.0, seed=seed)
-        body = build_body(walk.skeleton)
-        qpos = body.qpos_from_motion(walk)
-        upright["plain"] += not track(humanoid_model(body), qpos, walk.fps).fell
-        upright["search"] += not search_track(humanoid_model(body), qpos, walk.fps).result.fell
+        h = humanoid_for(walk)
+        upright["plain"] += not track(h.model, h.qpos, walk.fps).fell
+        upright["search"] += not search_track(h.model, h.qpos, walk.fps).result.fell
     n = len(seeds)
     return BenchRow(
         "upright[walk 10 s, search]",
@@ -65,12 +63,12 @@ def _upright_row() -> BenchRow:
 
 
 def _retarget_row(quick: bool) -> BenchRow:
-    path = MOCAP_DIR / CMU_CLIP
+    path = MOCAP_DIR / RETARGET_CLIP
     real = path.is_file()
     motion = load_motion(path) if real else generate("walk", duration_s=2.0)
     motion = motion[: 60 if quick else motion.n_frames]
     t0 = time.perf_counter()
-    retarget(motion)
+    retarget(motion, level_feet=True)
     wall = time.perf_counter() - t0
     return BenchRow(
         f"retarget[{path.stem if real else 'walk'}]",

@@ -2,7 +2,8 @@
 
 Prints the summary table, writes per-frame CSV, the contract JSON and a plot into ``--out``,
 optionally the MJCF and keyframes for MuJoCo's viewer into ``--export``. Exit 1 when a
-threshold fails, 2 for bad input (NaN, no frames, unknown rig, a rig that needs retargeting).
+threshold fails, 2 for bad input (NaN, no frames, unknown rig). A foreign rig is retargeted
+onto the humanoid (:func:`sim.humanoid.humanoid_for`) and its residual reported.
 """
 
 from __future__ import annotations
@@ -49,14 +50,15 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Physics plausibility of a motion on the MuJoCo humanoid. Exit 1 if a check fails."""
         check_outputs(json_out=json_out, out=out, export=export)
-        from sim.plausibility import body_and_motion, check_motion
+        from sim.humanoid import humanoid_for
+        from sim.plausibility import check_humanoid
         from sim.report import summary_rows, write_outputs
         from sim.thresholds import CheckConfig
 
         cfg = CheckConfig.from_toml(config) if config is not None else CheckConfig()
         m = load_motion_arg(motion, unit, seed, min_frames=MIN_FRAMES)
-        body, m = body_and_motion(m, None)
-        report = check_motion(m, body, cfg)
+        humanoid = humanoid_for(m)
+        report = check_humanoid(humanoid, cfg)
         report.meta.update(path=str(motion), seed=seed)
         table = Table(title=f"physics plausibility: {escape(motion)}")
         for col in ("check", "value", "threshold", "passed"):
@@ -70,7 +72,7 @@ def register(app: typer.Typer) -> None:
         if export is not None:
             from sim.export import export_replay
 
-            export_replay(body, body.qpos_from_motion(m), m.fps, export)
+            export_replay(humanoid, humanoid.qpos, m.fps, export)
             console.print(
                 escape(
                     f"MuJoCo viewer files in {export}/ (python -m mujoco.viewer --mjcf "

@@ -81,7 +81,7 @@ def register(app: typer.Typer) -> None:
             raise MotionValueError(f"--samples and --beam must be 1-{MAX_SEARCH}")
         check_outputs(json_out=json_out, out=out, out_owner="track", export=export)
         from scripts.results import atomic_dir
-        from sim.plausibility import body_and_motion
+        from sim.humanoid import humanoid_for
         from sim.sampling import SearchSettings, timed_tracking
         from sim.tracking import looped
         from sim.tracking_report import write_outputs
@@ -92,15 +92,14 @@ def register(app: typer.Typer) -> None:
                 f"the clip is {m.duration_s:.0f} s long; at most {MAX_TRACK_S:g} s are tracked "
                 "(pass --seconds)"
             )
-        body, m = body_and_motion(m, None, level_feet=True)
-        qpos = body.qpos_from_motion(m)
+        humanoid = humanoid_for(m, level_feet=True)
+        qpos = humanoid.qpos
         if seconds is not None:
             qpos = looped(qpos, m.fps, seconds)
         summary_extra = {"motion": motion, "seed": seed, "fps": m.fps}
-        if "retarget_residual_cm" in m.meta:
-            summary_extra["retarget_residual_cm"] = m.meta["retarget_residual_cm"]
+        summary_extra |= humanoid.summary()
         search = None if plain else SearchSettings(samples=samples, beam=beam, seed=seed)
-        result, summary = timed_tracking(body, qpos, m.fps, search, progress_bar=True)
+        result, summary = timed_tracking(humanoid.model, qpos, m.fps, search, progress_bar=True)
         summary |= summary_extra
         wall = summary["wall_s"]
         table = Table(title=f"physics tracking ({summary['mode']}): {escape(motion)}")
@@ -130,7 +129,7 @@ def register(app: typer.Typer) -> None:
         if export is not None:
             from sim.export import export_replay
 
-            export_replay(body, result.qpos, m.fps, export)
+            export_replay(humanoid, result.qpos, m.fps, export)
             console.print(
                 escape(
                     f"MuJoCo viewer files in {export}/ (python -m mujoco.viewer --mjcf "

@@ -1,45 +1,36 @@
-"""The humanoid: body from the motion's skeleton, its MJCF, the exact qpos, replay exactness."""
+"""The humanoid: built once for the ground truth by :func:`sim.humanoid.humanoid_for` (own rig:
+exact qpos; any other rig: retargeted, residual reported), its MJCF, replay exactness."""
 
 from __future__ import annotations
 
 import mujoco
 import numpy as np
 
-from avatar_models.body import build_body
 from scripts.results import write_atomic
 from scripts.run_context import RunContext
+from sim.humanoid import humanoid_for
 from sim.replay import replay_kinematic
-
-DEFAULT_MASS_KG = 75.0
 
 METRICS = {
     "replay_error_mm_max": "max distance between MuJoCo's replayed joints and the motion's FK",
+    "retarget_residual_cm_mean": "mean body17 distance of the humanoid from a foreign rig's "
+    "motion (0 on an own rig)",
 }
 
 
 def run(ctx: RunContext) -> None:
     spec = ctx.scenario.body
-    subject = ctx.motion.meta.get("subject") or {}
-    mass_kg = spec.mass_kg or subject.get("mass_kg", DEFAULT_MASS_KG)
-    ctx.body = build_body(ctx.motion.skeleton, height_m=spec.height_m, mass_kg=mass_kg)
-    xml = ctx.body.to_mjcf()
-    ctx.model = mujoco.MjModel.from_xml_string(xml)
-    ctx.qpos = ctx.body.qpos_from_motion(ctx.motion)
-    ctx.output("mjcf", write_atomic(ctx.out_dir / "humanoid.xml", xml))
+    h = ctx.humanoid = humanoid_for(ctx.motion, height_m=spec.height_m, mass_kg=spec.mass_kg)
+    ctx.motion = h.source  # the ground truth at the body's height
+    ctx.output("mjcf", write_atomic(ctx.out_dir / "humanoid.xml", h.mjcf))
 
     # Exactness of the pose -> qpos mapping: MuJoCo's bodies against the motion's FK.
-    trace = replay_kinematic(ctx.model, ctx.qpos)
-    sk = ctx.motion.skeleton
-    names = [
-        mujoco.mj_id2name(ctx.model, mujoco.mjtObj.mjOBJ_BODY, b) for b in range(ctx.model.nbody)
-    ]
+    trace = replay_kinematic(h.model, h.qpos)
+    sk = h.motion.skeleton
+    names = [mujoco.mj_id2name(h.model, mujoco.mjtObj.mjOBJ_BODY, b) for b in range(h.model.nbody)]
     pairs = np.array([(sk.index(n), b) for b, n in enumerate(names) if n in sk])
-    fk = ctx.motion.global_positions()[:, pairs[:, 0]]
+    fk = h.motion.global_positions()[:, pairs[:, 0]]
     err = np.linalg.norm(trace.body_pos[:, pairs[:, 1]] - fk, axis=-1)
     ctx.metrics["replay_error_mm_max"] = float(err.max() * 1000.0)
-    ctx.info["body"] = {
-        "mass_kg": mass_kg,
-        "nq": ctx.model.nq,
-        "nbody": ctx.model.nbody,
-        "joints_compared": len(pairs),
-    }
+    ctx.metrics["retarget_residual_cm_mean"] = float(np.mean(h.residual_cm))
+    ctx.info["body"] = h.summary() | {"nbody": h.model.nbody, "joints_compared": len(pairs)}

@@ -9,7 +9,7 @@ from __future__ import annotations
 from scripts.results import CheckResult
 from scripts.run_context import RunContext
 from scripts.scenario import Threshold
-from sim.plausibility import CONTRACT_KEYS, check_qpos
+from sim.plausibility import CONTRACT_KEYS, check_humanoid
 from sim.report import write_outputs
 from sim.thresholds import THRESHOLD_KEYS, CheckConfig
 
@@ -25,7 +25,7 @@ def config(ctx_or_table: RunContext | dict) -> CheckConfig:
 
 
 def run(ctx: RunContext) -> None:
-    report = check_qpos(ctx.body, ctx.qpos, ctx.motion.fps, config(ctx), model=ctx.model)
+    report = check_humanoid(ctx.humanoid, config(ctx))
     for row in report.thresholds:
         ctx.metrics[row["name"]] = float(row["value"])
         ctx.checks.append(

@@ -10,7 +10,8 @@ from avatar_models.measure import standing_height
 from avatar_models.motion import Motion
 from scripts.run_context import RunContext
 from scripts.scenario import Scenario, ScenarioError
-from sim.plausibility import check_motion
+from sim.humanoid import Humanoid, humanoid_for
+from sim.plausibility import check_humanoid
 from synthesis.base import Synthesizer
 from synthesis.coolmoves import CoolMoves, Options, build_database
 from synthesis.coolmoves.accuracy import body17_errors_cm, hand_correlation
@@ -63,8 +64,9 @@ def make_synthesizer(method: str, ctx: RunContext, user_height_m: float) -> Synt
     if method == "ik":
         from synthesis.ik_baseline import IKBaseline
 
-        # The IK baseline drives the same rig as the database, so errors compare like for like.
-        return IKBaseline(ctx.motion.skeleton, user_height_m=user_height_m)
+        # The IK baseline drives the humanoid's rig (the ground truth's own, or the avatar rig
+        # a foreign rig was retargeted onto), so errors compare like for like.
+        return IKBaseline(ctx.humanoid.body.skeleton, user_height_m=user_height_m)
     raise ScenarioError(f"unknown synthesis method {method!r}; known: {', '.join(METHODS)}")
 
 
@@ -75,15 +77,15 @@ def run(ctx: RunContext) -> None:
     stream = ctx.artifacts["vr_stream"]
     subject = ctx.motion.meta.get("subject") or {}
     user_height_m = subject.get("height_m") or standing_height(ctx.motion)
-    outputs: dict[str, Motion] = {}
+    outputs: dict[str, Humanoid] = {}
     for method in spec.methods:
         output = make_synthesizer(method, ctx, user_height_m).run(stream)
-        outputs[method] = output
+        outputs[method] = humanoid = humanoid_for(output)
         for group, value in body17_errors_cm(output, ctx.motion).items():
             ctx.metrics[f"{method}_err_cm_{group}"] = value
         corr = hand_correlation(output, stream)
         ctx.metrics[f"{method}_hand_corr_min"] = min(corr.values())
-        physics = check_motion(output).values
+        physics = check_humanoid(humanoid).values
         ctx.metrics[f"{method}_skate_cm_s_median"] = physics["skate_cm_s_median"]
         ctx.metrics[f"{method}_penetration_cm_p95"] = physics["penetration_cm_p95"]
         ctx.info.setdefault("synthesis", {})[method] = {

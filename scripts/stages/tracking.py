@@ -28,9 +28,10 @@ def run(ctx: RunContext) -> None:
     if spec is None:
         return
     fps = ctx.motion.fps
-    qpos = looped(ctx.qpos, fps, spec.seconds)
+    reference = ctx.humanoid.for_tracking()
+    qpos = looped(reference.qpos, fps, spec.seconds)
     search = SearchSettings() if spec.search else None
-    result, summary = timed_tracking(ctx.body, qpos, fps, search)
+    result, summary = timed_tracking(reference.model, qpos, fps, search)
     upright = summary["duration_s"] if result.fall_time_s is None else result.fall_time_s
     ctx.metrics |= {
         "tracking_fell": float(not summary["completed"]),

@@ -21,7 +21,7 @@ from sim.retarget import (
     stance_feet,
     swinging_feet,
 )
-from sim.soles import FEET, box_corners, corner_positions, sole_boxes
+from sim.soles import box_corners, corner_positions, foot_bodies, sole_boxes
 
 BANDAI_WALK = "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh"
 
@@ -89,7 +89,7 @@ def _lowest_sole_corners(body, qpos: np.ndarray) -> np.ndarray:
     """``(T, 2)`` height of the lowest sole-box corner of the left and right foot."""
     model = humanoid_model(body)
     data = mujoco.MjData(model)
-    boxes = [sole_boxes(model, (foot,)) for foot in FEET]
+    boxes = [sole_boxes(model, (foot,)) for foot in foot_bodies(model)]
     low = np.empty((qpos.shape[0], 2))
     for t, q in enumerate(qpos):  # MuJoCo evaluates one configuration per call
         data.qpos[:] = q

@@ -1,0 +1,148 @@
+"""The one path from any motion to the MuJoCo humanoid: :func:`humanoid_for`.
+
+Every command and scenario stage gets its body, qpos and compiled model from here, once, and
+passes the :class:`Humanoid` along; nothing downstream rebuilds a body from a skeleton.
+
+- A motion on a rig whose rest pose stands (the avatar rig, CMU, a built-in subject) gets the
+  body of its own skeleton and its exact qpos (:meth:`BodyDescription.qpos_from_motion`):
+  residual zero.
+- Any other rig with a body17 map (Bandai, Kinect...) is retargeted onto the avatar-rig
+  humanoid sized to it (:func:`sim.retarget.humanoid_body`, :func:`sim.retarget.retarget`);
+  its per-frame residual is kept.
+
+Physics tracking needs stance feet flat on the floor (:func:`sim.retarget.level_stance_feet`
+and the repairs around it); :meth:`Humanoid.for_tracking` gives that reference on the same body
+and model, retargeting again only for a foreign rig.
+
+Shapes: ``T`` frames, ``nq`` MuJoCo position coordinates.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from avatar_models.body import BodyDescription, BodyError, build_body
+from avatar_models.errors import MotionValueError
+from avatar_models.measure import standing_height
+from avatar_models.motion import Motion
+
+DEFAULT_MASS_KG = 75.0
+
+
+@dataclass(frozen=True, eq=False)
+class Humanoid:
+    """A motion on the humanoid.
+
+    Attributes:
+        body: the body, built once.
+        motion: the motion on ``body.skeleton`` (the source itself for an own rig).
+        qpos: ``(T, nq)`` MuJoCo positions of ``motion``.
+        residual_cm: ``(T,)`` mean body17 site-to-target distance of the retargeting (zeros
+            for an own rig).
+        source: the motion as given (after any height scaling).
+        mjcf: the body's MJCF, generated once.
+        model: ``mjcf`` compiled once, shared by every stage: read it, do not edit it (the
+            tracker works on a copy of its own).
+        levelled: whether stance feet were levelled for tracking.
+    """
+
+    body: BodyDescription
+    motion: Motion
+    qpos: np.ndarray
+    residual_cm: np.ndarray
+    source: Motion
+    mjcf: str
+    model: mujoco.MjModel
+    levelled: bool = False
+
+    @property
+    def retargeted(self) -> bool:
+        return self.motion is not self.source
+
+    def for_tracking(self) -> Humanoid:
+        """This humanoid with stance feet levelled for physics tracking (module docstring);
+        itself for an own rig, whose feet are the source's."""
+        if not self.retargeted or self.levelled:
+            return self
+        return _levelled(self)
+
+    def summary(self) -> dict:
+        """Provenance for results files: rig, retargeting and its residual."""
+        out = {
+            "source_rig": self.source.skeleton.name,
+            "body_rig": self.body.rig.name,
+            "retargeted": self.retargeted,
+            "mass_kg": self.body.mass_kg,
+            "nq": int(self.qpos.shape[1]),
+        }
+        if self.retargeted:
+            out["retarget_residual_cm_mean"] = float(np.mean(self.residual_cm))
+            out["retarget_residual_cm_p95"] = float(np.percentile(self.residual_cm, 95))
+        return out
+
+
+def humanoid_for(
+    motion: Motion,
+    height_m: float | None = None,
+    mass_kg: float | None = None,
+    level_feet: bool = False,
+) -> Humanoid:
+    """The humanoid for ``motion`` (module docstring).
+
+    Args:
+        motion: any rig with a body17 map.
+        height_m: scale the motion uniformly (skeleton and root path) to this standing
+            height first; ``None`` keeps its own size.
+        mass_kg: body mass (default: the built-in subject's, else 75 kg).
+        level_feet: level stance feet for tracking right away (see :meth:`for_tracking`).
+
+    Raises:
+        MotionValueError: a rig with no body17 map, a height outside (0, 3] m.
+        BodyError: a skeleton no body can be built from.
+    """
+    if mass_kg is None:
+        mass_kg = (motion.meta.get("subject") or {}).get("mass_kg", DEFAULT_MASS_KG)
+    if height_m is not None:
+        if not (np.isfinite(height_m) and 0.0 < height_m <= 3.0):
+            raise MotionValueError(f"body height must be in (0, 3] m, got {height_m!r}")
+        factor = height_m / standing_height(motion)
+        motion = motion.replace(
+            skeleton=motion.skeleton.scaled(factor), root_pos=motion.root_pos * factor
+        )
+    try:
+        body = build_body(motion.skeleton, mass_kg=mass_kg)
+    except BodyError as exc:
+        if "not upright" not in str(exc):
+            raise
+    else:
+        mjcf = body.to_mjcf()
+        qpos = body.qpos_from_motion(motion)
+        zero = np.zeros(motion.n_frames)
+        return Humanoid(body, motion, qpos, zero, motion, mjcf, _compile(mjcf))
+    from sim.retarget import humanoid_body  # IK (mink) is only loaded when needed
+
+    body = humanoid_body(motion, mass_kg=mass_kg)
+    mjcf = body.to_mjcf()
+    return _retargeted(body, motion, mjcf, _compile(mjcf), level_feet)
+
+
+def _compile(mjcf: str) -> mujoco.MjModel:
+    return mujoco.MjModel.from_xml_string(mjcf)
+
+
+def _retargeted(
+    body: BodyDescription, motion: Motion, mjcf: str, model: mujoco.MjModel, level_feet: bool
+) -> Humanoid:
+    from sim.retarget import retarget
+
+    result = retarget(motion, body, level_feet=level_feet, scale_targets=False, model=model)
+    meta = {**result.motion.meta, "retarget_residual_cm": float(np.mean(result.residual_cm))}
+    out = result.motion.replace(meta=meta)
+    return Humanoid(body, out, result.qpos, result.residual_cm, motion, mjcf, model, level_feet)
+
+
+def _levelled(h: Humanoid) -> Humanoid:
+    return _retargeted(h.body, h.source, h.mjcf, h.model, level_feet=True)
