@@ -28,8 +28,13 @@ skating are measured in the floor frame (floor at z = 0, Z up):
   above ``skate_speed_cm_s``; a stance (run of contact frames) slides by its slip velocity
   summed over the stance (how far the contact moved on the floor). The
   humanoid's foot is one rigid box without a toe joint, so the sole's points move during
-  push-off even in clean mocap (CMU running: stance median 18-25 cm/s); the median threshold
-  (40 cm/s) leaves room for that, the slide threshold (10 cm per stance) catches slow drift.
+  push-off even in clean mocap; the median threshold (40 cm/s) leaves room for that, the
+  slide threshold (10 cm per stance) catches slow drift. Measured on clean motion
+  (``python -m tests.measurements.check_values``, and ``... --bandai``): clip medians CMU
+  running 14-17 cm/s, other CMU clips 0-8, six Bandai clips 0.1-8.3, built-in activities 0.
+  Worst slides: most clips 0-5 cm, but CMU 14_33 (ladder) 10.1, 06_06 (basketball) 13.0,
+  125_01 (swimming) 31, Bandai dataset-1 punch 20 and dataset-2 walk 54 cm: those clean
+  clips are flagged for skating.
 - **joint limits**: a hinge, or the total rotation of a chain of joints sharing one range (the
   spine's, the neck's), beyond its anatomical range (the body's AAOS ranges) by more than
   ``limit_tolerance_deg``; the clip's value is the share of frames with any such hinge. AAOS
@@ -41,8 +46,11 @@ skating are measured in the floor frame (floor at z = 0, Z up):
   soft tissue, which a swinging arm compresses against the hip by centimetres); share of
   frames.
 - **jitter**: mean over bodies of the jerk magnitude (m/s^3, third finite difference of body
-  positions); the clip's value is the median over frames (noise raises every frame). Clean
-  CMU mocap at 120 Hz: 3-4k m/s^3 from marker noise, 1 cm noise at 90 Hz: ~50k.
+  positions); the clip's value is the median over frames (noise raises every frame).
+  Measured (``python -m tests.measurements.check_values``): CMU at 120 Hz 2.9-4.3k m/s^3
+  for running and basketball, 1.0-1.1k for the ladder, 0.07-0.17k for swimming; six Bandai
+  clips at 30 Hz 0.015-0.6k; built-in activities at 90 Hz 0.001-1.9k (run the highest);
+  the built-in walk with 1 cm of root noise at 90 Hz: 47.5k.
 - **balance**: signed distance of the centre of mass projected on the floor outside the
   support polygon (ConvexHull of the foot sole corners in contact), cm; informative only,
   walking is dynamically, not statically, balanced.

@@ -47,9 +47,10 @@ Nothing acts on the root: no actuator on the free joint, ``xfrc_applied`` and
 ``qfrc_applied`` stay zero (tested). Only the floor collides with the body (limbs of
 retargeted clips overlap, and forces between them would be unknown to the controller).
 
-On its own the controller walks a few steps (the built-in walk: 2.3-4.3 s over seeds 0-5;
-Bandai walks retargeted with ``level_feet``: 2-3.2 s); :mod:`sim.sampling` searches over its
-targets for walks of 10 s and more.
+On its own the controller walks a few steps (built-in 4 s walks: a fall at 2.1-3.8 s or none;
+one sampled subject fell at 1.3 s, tests/measurements/walk_spread.py; Bandai walks retargeted
+with ``level_feet``: 2-3.2 s); :mod:`sim.sampling` searches over its targets for walks of 10 s
+and more.
 
 A fall (after Peng et al. 2018, DeepMimic, whose episodes end when the character falls) is
 the first frame where the head is below :attr:`TrackingSettings.fall_head_ratio` of the

@@ -229,3 +229,44 @@ def test_amc_to_bvh_roundtrip(tmp_path):
     assert back.n_frames == m.n_frames
     assert back.fps == pytest.approx(m.fps)
     np.testing.assert_allclose(back.global_positions(), m.global_positions(), atol=1e-5)
+
+
+def test_softimage_order_preset_position_and_dof_order_worked_by_hand():
+    """Facts of the format, worked on paper (no FK code, no parsed values): the VICON/CMU
+    notes on the ASF ("Acclaim Format - ASF line Details", graphics.cs.cmu.edu/nsp/course/
+    cs229/info/ACCLAIMdef.html) say the root's ``order`` line gives both the order of the
+    AMC's root values and the sequence in which the root rotations are applied about fixed
+    global axes, and that the root's pre-set ``position`` offsets all the motion. A bone's
+    rotation is ``C M C^-1`` about its ``axis`` frame C (Lander 1998), its dofs applied in
+    the order listed like the root's. ``length 0.45``: 1 unit = 1/0.45 inch.
+
+    softimage.asf, Y up, file units: root pre-set at (1,0,0); bone up = 4 along +Y, dofs
+    ``rz rx``; bone side = 2 along +X, C = Rz(90) (C's x axis is world +Y), dof ``rx``.
+    Rz(90): (x,y,z) -> (-y,x,z); Ry(90): (x,y,z) -> (z,y,-x); Rx(90): (x,y,z) -> (x,-z,y).
+
+    1. rest: root (1,0,0), up tip (1,4,0), side tip (3,4,0).
+    2. root rz 90: up (0,4,0) -> (-4,0,0), side (2,0,0) -> (0,2,0): (-3,0,0), (-3,2,0).
+    3. root rz 90 THEN ry 90 (order line): up (0,4,0) -Rz-> (-4,0,0) -Ry-> (0,0,4); side
+       (2,0,0) -Rz-> (0,2,0) -Ry-> (0,2,0): (1,0,4), (1,2,4). (Ry first would give
+       up -> (-4,0,0): the test tells the orders apart.)
+    4. up rz 90 THEN rx 90: up (0,4,0) -Rz-> (-4,0,0) -Rx-> (-4,0,0); side (2,0,0) -Rz->
+       (0,2,0) -Rx-> (0,0,2): (-3,0,0), (-3,0,2). (rx first: up tip (1,0,4).)
+    5. root tz 5 (plus the pre-set): (1,0,5); side rx 90 turns about C's x = world +Y:
+       (2,0,0) -> (0,0,-2): up tip (1,4,5), side tip (1,4,3).
+    """
+    m = load_motion(DATA / "softimage.amc", asf=DATA / "softimage.asf")
+    assert m.skeleton.names == ("root", "up", "side", "side_end")
+    # joint "up" sits where bone up starts (the root), "side" at up's tip, "side_end" at
+    # side's tip.
+    expected = np.array(
+        [
+            [[1, 0, 0], [1, 0, 0], [1, 4, 0], [3, 4, 0]],
+            [[1, 0, 0], [1, 0, 0], [-3, 0, 0], [-3, 2, 0]],
+            [[1, 0, 0], [1, 0, 0], [1, 0, 4], [1, 2, 4]],
+            [[1, 0, 0], [1, 0, 0], [-3, 0, 0], [-3, 0, 2]],
+            [[1, 0, 5], [1, 0, 5], [1, 4, 5], [1, 4, 3]],
+        ],
+        dtype=float,
+    )
+    metres = INCH / 0.45
+    np.testing.assert_allclose(m.global_positions(), _to_z_up(expected) * metres, atol=1e-9)

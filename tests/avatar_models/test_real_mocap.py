@@ -20,6 +20,7 @@ from avatar_models.formats.bvh import read_bvh, write_bvh
 from avatar_models.formats.units import Y_UP_TO_Z_UP
 from avatar_models.measure import bone_lengths_over_time, lowest_point, standing_height
 from avatar_models.rigs import body17_positions, identify_rig
+from tests.conftest import require_module
 
 pytestmark = pytest.mark.mocap
 
@@ -45,14 +46,33 @@ def clips(mocap_dir: Path) -> dict[str, object]:
     return out
 
 
+# What the shared folder's README says of each source: file unit and frame rate.
+SOURCE_FACTS = {"cmu": ("cmu", 120.0), "bandai": ("cm", 30.0)}
+
+
 def test_every_clip_loads_with_its_rig(clips):
+    """Every clip, not one per source: its rig, unit and frame rate are those the shared
+    README gives for its source, its arrays are finite, it has frames to speak of. (Heights
+    and bone lengths of every clip are checked below.)"""
     failures = {k: repr(v) for k, v in clips.items() if isinstance(v, Exception)}
     assert len(clips) >= 390 and not failures
-    units = {k.split("/")[0]: m.meta["unit"] for k, m in clips.items()}
-    assert units == {"cmu": "cmu", "bandai": "cm"}
+    per_source = {s: [k for k in clips if k.split("/")[0] == s] for s in SOURCE_FACTS}
+    assert len(per_source["cmu"]) == 9 and len(per_source["bandai"]) >= 384
+    wrong = {}
     for key, motion in clips.items():
-        assert identify_rig(motion.skeleton).name == key.split("/")[0], key
-        assert body17_positions(motion).shape == (motion.n_frames, 17, 3)
+        source = key.split("/")[0]
+        unit, fps = SOURCE_FACTS[source]
+        got = (identify_rig(motion.skeleton).name, motion.meta["unit"], motion.fps)
+        if got != (source, unit, fps):
+            wrong[key] = got
+        b17 = body17_positions(motion)
+        if b17.shape != (motion.n_frames, 17, 3) or not np.isfinite(b17).all():
+            wrong[key] = "body17 not finite (T, 17, 3)"
+        if not (np.isfinite(motion.root_pos).all() and np.isfinite(motion.local_rot).all()):
+            wrong[key] = "non-finite root or rotations"
+        if motion.n_frames < 10:  # the shortest real clips (Bandai dash, run) last 0.6 s
+            wrong[key] = f"only {motion.n_frames} frames"
+    assert not wrong, wrong
 
 
 def test_bone_lengths_are_constant(clips):
@@ -86,7 +106,7 @@ def test_clips_walk_forward_with_left_on_the_left(clips):
 
 
 def _bvhio_positions(path: Path, frames: list[int]) -> dict[str, np.ndarray]:
-    bvhio = pytest.importorskip("bvhio")
+    bvhio = require_module("bvhio")
     root = bvhio.readAsHierarchy(str(path))
     out: dict[str, list] = {}
     for frame in frames:

@@ -210,3 +210,44 @@ def test_single_joint_keeps_its_own_limit(rest_body):
     r = _joint_limits(rest_body, {"Bip01 L Calf": (165.0, "y")})
     assert list(r.details["violations"]) == ["Bip01 L Calf:ry"]
     assert r.details["violations"]["Bip01 L Calf:ry"]["max_deg"] == pytest.approx(30.0)
+
+
+def crossed_forearms(body, frames: int = 10) -> Motion:
+    """The rest pose (a T-pose) with both upper arms turned 85 degrees forward and both
+    elbows bent 95 degrees inward: each forearm points straight at the other shoulder (85 +
+    95 = 180), and both lie on one line in front of the chest at shoulder height, so the
+    forearms and hands pass through each other, which no body can do. (85 rather than 90
+    keeps the shoulder's Euler decomposition out of gimbal lock.)"""
+    m = still_pose(body, 0.0, frames)
+    rot = m.local_rot.copy()
+    sk = body.skeleton
+    for side, sign in (("L", -1.0), ("R", 1.0)):  # left arm: rest +Y, forward is -Z turn
+        for joint, deg in (("UpperArm", 85.0), ("Forearm", 95.0)):
+            turn = Rotation.from_euler("z", sign * deg, degrees=True)
+            rot[:, sk.index(f"Bip01 {side} {joint}")] = quat.from_scipy(turn)
+    return m.replace(local_rot=rot)
+
+
+def test_self_collision_flags_forearms_through_each_other_not_the_rest_pose(rest_body):
+    """Two coaxial capsules of radius r overlap by 2 r: the check must report that depth
+    (the forearm capsules' radius from the model, not a check constant) and flag every
+    frame; the rest pose has no self-contact at all."""
+    rest = check_motion(still_pose(rest_body, 0.0, 10), rest_body)
+    assert rest.values["self_collision_frac"] == 0.0
+    assert not rest.per_frame()["self_collision_cm"].any()
+    crossed = crossed_forearms(rest_body)
+    pos = crossed.global_positions()[0]
+    sk = rest_body.skeleton
+    l_hand, r_hand = pos[sk.index("Bip01 L Hand")], pos[sk.index("Bip01 R Hand")]
+    assert l_hand[1] < 0.0 < r_hand[1]  # each hand is past the midline, on the other side
+    assert l_hand[0] > 0.2 and abs(l_hand[2] - r_hand[2]) < 1e-9  # in front, one height
+    report = check_motion(crossed, rest_body)
+    model = mujoco.MjModel.from_xml_string(rest_body.to_mjcf())
+    forearm = model.body("Bip01 L Forearm").id
+    (geom,) = np.flatnonzero(model.geom_bodyid == forearm)
+    assert model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_CAPSULE
+    depth_cm = report.per_frame()["self_collision_cm"]
+    np.testing.assert_allclose(depth_cm, 2 * 100 * model.geom_size[geom, 0], rtol=0.02)
+    assert report.values["self_collision_frac"] == 1.0 and report.flagged("self_collision")
+    pairs = report.contract()["details"]["self_collision"]["pairs"]
+    assert "Bip01 L Forearm / Bip01 R Forearm" in pairs, pairs

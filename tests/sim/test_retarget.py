@@ -52,6 +52,7 @@ def test_given_body_scales_the_targets():
     assert ratio == pytest.approx(1.6 / 1.95, rel=0.05)
 
 
+@pytest.mark.mocap
 def test_joint_limits_hold(mocap_dir):
     motion = load_motion(mocap_dir / "cmu" / "09_01.bvh")[::4]
     body = fitted_body(motion)
@@ -99,6 +100,7 @@ def _lowest_sole_corners(body, qpos: np.ndarray) -> np.ndarray:
     return low
 
 
+@pytest.mark.mocap
 def test_levelled_real_walk_stands_flat_and_swings_clear(mocap_dir):
     """With ``level_feet`` the Bandai walk stands on flat soles, lifts its swinging soles
     3 cm clear (so a simulated toe does not catch the floor) and digs into the floor nowhere

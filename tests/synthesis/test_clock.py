@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import time
-
 import numpy as np
 import pytest
 
@@ -21,13 +19,13 @@ def walk():
 
 
 @pytest.mark.parametrize("glitch_s", [1000.0, 1e5])
-def test_one_glitched_timestamp_is_dropped_and_the_run_stays_fast(walk, glitch_s):
+def test_one_glitched_timestamp_is_dropped_not_stepped_through(walk, glitch_s):
     motion, stream = walk
     ts = stream.timestamps.copy()
     ts[40] = glitch_s
-    start = time.perf_counter()
     out = IKBaseline(motion.skeleton, standing_height(motion)).run(stream.replace(timestamps=ts))
-    assert time.perf_counter() - start < 1.0
+    # One output frame per tick of the real clock: the glitch did not open a gap of
+    # glitch_s * 90 ticks to step through (which is what made such runs take minutes).
     assert out.n_frames == motion.n_frames  # the glitched sample's tick is stepped as missing
     assert np.isfinite(out.root_pos).all() and np.isfinite(out.local_rot).all()
     assert out.meta["stream"]["repairs"]["clock_outliers"] == 1
