@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.errors import RigError
+from avatar_models.errors import MotionFormatError, MotionValueError, RigError
 from avatar_models.motion import Motion
 from avatar_models.rigs import identify_rig
 from avatar_models.skeleton import Skeleton
@@ -91,3 +91,31 @@ def bone_lengths_over_time(motion: Motion) -> np.ndarray:
     parents = motion.skeleton.parents.copy()
     parents[0] = 0
     return np.linalg.norm(pos - pos[:, parents], axis=-1)
+
+
+# Standing heights a motion of a person can have (metres): a small child to a very tall adult.
+PLAUSIBLE_HEIGHT_M = (0.5, 2.5)
+
+
+def check_plausible_height(motion: Motion) -> float:
+    """The motion's standing height (m); a :class:`MotionValueError` when it is no person's,
+    which after a unit conversion means the wrong unit (the message names the one that fits)."""
+    from avatar_models.formats.units import detect_unit
+
+    height = standing_height(motion)
+    lo, hi = PLAUSIBLE_HEIGHT_M
+    if lo <= height <= hi:
+        return height
+    unit = motion.meta.get("unit")
+    scale = motion.meta.get("unit_scale_m") or motion.meta.get("metres_per_unit")
+    used = f" with unit {unit!r}" if isinstance(unit, str) and unit != "custom" else ""
+    hint = ""
+    if scale:
+        try:
+            name, _ = detect_unit(height / scale)
+            hint = f"; its lengths fit unit {name!r} (--unit {name})"
+        except MotionFormatError:
+            pass
+    raise MotionValueError(
+        f"the body is {height:.3g} m tall{used}, not a person's height ({lo:g}-{hi:g} m){hint}"
+    )

@@ -19,8 +19,19 @@ from avatar_models import quat
 from avatar_models.errors import MotionValueError
 from avatar_models.skeleton import Skeleton
 
+# Frame rates a motion may have (frames per second): mocap runs at 30-480 Hz, a 1 kHz system
+# is the fastest one records BVH from; anything outside is a wrong Frame Time or --fps.
+FPS_RANGE = (1.0, 1000.0)
+
 # Reflection across the sagittal (XZ) plane: a character's left is +Y.
 _MIRROR = np.diag([1.0, -1.0, 1.0])
+
+
+def check_fps(fps: float, what: str = "fps") -> None:
+    """A :class:`MotionValueError` unless ``fps`` is in :data:`FPS_RANGE`."""
+    lo, hi = FPS_RANGE
+    if not (isinstance(fps, int | float | np.number) and np.isfinite(fps) and lo <= fps <= hi):
+        raise MotionValueError(f"{what} must be {lo:g}-{hi:g} frames per second, got {fps!r}")
 
 
 def _depth_levels(parents: np.ndarray) -> list[np.ndarray]:
@@ -53,8 +64,7 @@ class Motion:
         root = np.asarray(self.root_pos, dtype=float)
         rot = np.asarray(self.local_rot, dtype=float)
         nj = self.skeleton.n_joints
-        if not (np.isfinite(self.fps) and self.fps > 0):
-            raise MotionValueError(f"fps must be a positive number, got {self.fps!r}")
+        check_fps(self.fps)
         if rot.ndim != 3 or rot.shape[1:] != (nj, 4):
             raise MotionValueError(f"local_rot must be (T, {nj}, 4), got {rot.shape}")
         if root.shape != (rot.shape[0], 3):
@@ -197,8 +207,7 @@ class Motion:
 
     def resample(self, fps: float) -> Motion:
         """Same clip at ``fps`` frames per second (the duration is kept, rounded down)."""
-        if not (np.isfinite(fps) and fps > 0):
-            raise MotionValueError(f"target fps must be positive, got {fps!r}")
+        check_fps(fps, "target fps")
         n = int(np.floor(self.duration_s * fps + 1e-9)) + 1
         return self.sample(np.arange(n) / fps).replace(fps=fps)
 

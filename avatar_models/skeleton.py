@@ -84,6 +84,10 @@ class Skeleton:
         if not np.all(np.isfinite(offsets)):
             raise MotionValueError("skeleton offsets contain NaN or inf")
         is_site = np.zeros(n, bool) if self.is_site is None else np.asarray(self.is_site, bool)
+        if is_site.shape != (n,):
+            raise MotionValueError(
+                f"is_site must hold one flag per joint ({n}), got {is_site.shape}"
+            )
         for jname in self.limits:
             if jname not in names:
                 raise UnknownJointError(jname, names)

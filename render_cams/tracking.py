@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -24,6 +23,7 @@ from typing import Any
 import numpy as np
 
 from avatar_models import AvatarsimError
+from avatar_models.fileio import atomic_file
 
 # Fixed zip entry time so that the same stream always gives the same file bytes.
 _ZIP_EPOCH = (1980, 1, 1, 0, 0, 0)
@@ -257,21 +257,15 @@ class TrackingStream:
             "valid": self.valid,
             "meta": np.array(json.dumps(self.meta, sort_keys=True)),
         }
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-        try:
-            with os.fdopen(fd, "wb") as fh:
-                with zipfile.ZipFile(fh, "w", zipfile.ZIP_DEFLATED) as zf:
-                    for key, arr in entries.items():
-                        info = zipfile.ZipInfo(f"{key}.npy", date_time=_ZIP_EPOCH)
-                        info.compress_type = zipfile.ZIP_DEFLATED
-                        with zf.open(info, "w") as entry:
-                            np.lib.format.write_array(entry, np.asarray(arr), allow_pickle=False)
-                fh.flush()
-                os.fsync(fh.fileno())
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+        with atomic_file(path) as fh:
+            with zipfile.ZipFile(fh, "w", zipfile.ZIP_DEFLATED) as zf:
+                for key, arr in entries.items():
+                    info = zipfile.ZipInfo(f"{key}.npy", date_time=_ZIP_EPOCH)
+                    info.compress_type = zipfile.ZIP_DEFLATED
+                    with zf.open(info, "w") as entry:
+                        np.lib.format.write_array(entry, np.asarray(arr), allow_pickle=False)
+            fh.flush()
+            os.fsync(fh.fileno())
         return path
 
     @classmethod

@@ -22,6 +22,7 @@ from avatar_models.errors import AvatarsimError
 from scripts.cli_common import (
     JsonOpt,
     SeedOpt,
+    check_outputs,
     console,
     emit_json,
     err_console,
@@ -46,9 +47,19 @@ def info(
     json_out: JsonOpt = None,
 ) -> None:
     """Skeleton, fps, frames and size of a motion file."""
-    from avatar_models.measure import standing_height
+    from avatar_models.errors import MotionValueError
+    from avatar_models.measure import check_plausible_height, standing_height
 
-    m = load_motion_arg(motion, unit, seed)
+    check_outputs(json_out=json_out)
+    m = load_motion_arg(motion, unit, seed, check_height=False)
+    notes = []
+    try:
+        check_plausible_height(m)
+    except MotionValueError as exc:
+        notes.append(f"[yellow]warning:[/] {escape(str(exc))}; other commands refuse it")
+    dropped = m.meta.get("dropped_frames")
+    if dropped:
+        notes.append(f"dropped frame(s) {dropped['frames']} of the file: {dropped['reason']}")
     payload = {
         "path": str(motion),
         "joints": m.skeleton.n_joints,
@@ -57,12 +68,15 @@ def info(
         "frames": m.n_frames,
         "duration_s": m.duration_s,
         "height_m": standing_height(m),
+        "dropped_frames": dropped or None,
     }
-    table = Table(title=Path(motion).name, show_header=False)
+    table = Table(title=escape(Path(motion).name), show_header=False)
     for key in ("joints", "fps", "frames", "duration_s", "height_m"):
         value = payload[key]
         table.add_row(key, f"{value:.3f}" if isinstance(value, float) else str(value))
     console.print(table)
+    for note in notes:
+        console.print(note, highlight=False, soft_wrap=True)
     emit_json(json_out, payload)
 
 
@@ -77,13 +91,22 @@ def convert(
     json_out: JsonOpt = None,
 ) -> None:
     """Convert BVH / ASF+AMC / NPZ to BVH or NPZ, optionally resampled."""
-    from avatar_models.formats import save_motion
+    from avatar_models.formats import WRITABLE, save_motion
+    from avatar_models.motion import check_fps
 
+    if fps is not None:
+        check_fps(fps, "--fps")
+    check_outputs(json_out=json_out, files={"OUT": dst})
+    if dst.suffix.lower() not in WRITABLE:
+        raise AvatarsimError(
+            f"OUT {dst}: cannot write {dst.suffix or 'a file without suffix'}; "
+            f"writable: {', '.join(WRITABLE)}"
+        )
     m = load_motion_arg(src, unit, seed)
     if fps is not None:
         m = m.resample(fps)
     save_motion(m, dst)
-    console.print(f"wrote {dst}: {m.n_frames} frames at {m.fps:g} fps")
+    console.print(f"wrote {escape(str(dst))}: {m.n_frames} frames at {m.fps:g} fps")
     emit_json(json_out, {"src": str(src), "dst": str(dst), "frames": m.n_frames, "fps": m.fps})
 
 
@@ -91,14 +114,15 @@ def _run(scenario_obj: Any, out: Path, json_out: Path | None) -> None:
     from scripts.pipeline import run_scenario
 
     results = run_scenario(scenario_obj, out, err_console)
-    table = Table(title=f"scenario {results['scenario']}")
+    table = Table(title=f"scenario {escape(results['scenario'])}")
     for col in ("check", "value", "threshold", "passed"):
         table.add_column(col)
     for c in results["checks"]:
         mark = "[green]yes[/]" if c["passed"] else "[red]NO[/]"
-        table.add_row(c["name"], f"{c['value']:.4g}", str(c["threshold"]), mark)
+        table.add_row(c["name"], f"{c['value']:.4g}", escape(str(c["threshold"])), mark)
     console.print(table)
-    console.print(f"results in {out}/ ({', '.join(sorted(results['outputs'].values()))})")
+    outputs = ", ".join(sorted(results["outputs"].values()))
+    console.print(f"results in {escape(str(out))}/ ({escape(outputs)})")
     emit_json(json_out, results)
     if not results["passed"]:
         raise typer.Exit(1)
@@ -117,6 +141,7 @@ def run(
     """Run a scenario: source -> devices -> methods -> checks. Exit 1 if a threshold fails."""
     from scripts.scenario import load_scenario
 
+    check_outputs(json_out=json_out, out=out, out_owner="run")
     sc = load_scenario(scenario)
     if seed is not None:
         sc = dataclasses.replace(sc, seed=seed)
@@ -133,6 +158,7 @@ def demo(
     """The default scenario on built-in motion, end to end (results, pictures)."""
     from scripts.scenario import DEFAULT_SCENARIO, load_scenario
 
+    check_outputs(json_out=json_out, out=out, out_owner="run")
     sc = dataclasses.replace(load_scenario(DEFAULT_SCENARIO), seed=seed)
     _run(sc, out, json_out)
 
@@ -148,6 +174,8 @@ def bench(
     """Benchmarks: prints a table, writes JSON (name, unit, value, baseline, ratio)."""
     from scripts.benchmarks import BENCHMARKS, run_benchmark
 
+    json_out = json_out or Path("out/bench/bench.json")
+    check_outputs(json_out=json_out)
     names = list(BENCHMARKS) if name is None else [name]
     unknown = [n for n in names if n not in BENCHMARKS]
     if unknown:
@@ -165,7 +193,7 @@ def bench(
     console.print(table)
     # Benchmark inputs are fixed (seeded inside each module); the seed is recorded as asked.
     payload = {"seed": seed, "benchmarks": [r.to_json() for r in rows]}
-    emit_json(json_out or Path("out/bench/bench.json"), payload)
+    emit_json(json_out, payload)
 
 
 for _module in pkgutil.iter_modules(scripts.commands.__path__):

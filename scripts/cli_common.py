@@ -6,16 +6,22 @@ CLI discovers them, so adding a command never edits ``cli.py``.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import os
-from collections.abc import Callable
+import signal
+import threading
+import warnings
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Annotated, Any
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 
-from avatar_models.errors import AvatarsimError
+from avatar_models.errors import AvatarsimError, MotionValueError
+from scripts.scenario import MIN_FRAMES  # noqa: F401  (re-exported for the commands)
 
 INTERNAL_ERROR = 3  # exit code of a bug (0 ok, 1 a check failed, 2 bad input)
 
@@ -35,34 +41,127 @@ JsonOpt = Annotated[Path | None, typer.Option("--json", help="Also write the res
 SeedOpt = Annotated[int, typer.Option("--seed", help="Seed for everything stochastic.")]
 
 
+def _one_line(text: object) -> str:
+    """User text for rich: on one line, with ``[...]`` shown as written (not as markup)."""
+    return escape(" ".join(str(text).split()))
+
+
+def _check_common(kwargs: dict[str, Any]) -> None:
+    """Options every command shares, checked before the command runs."""
+    seed = kwargs.get("seed")
+    if isinstance(seed, int) and seed < 0:
+        raise AvatarsimError(f"--seed must be 0 or more (numpy's generators), got {seed}")
+    motion = kwargs.get("motion", kwargs.get("src"))
+    if kwargs.get("unit") is not None and str(motion).startswith(BUILTIN_PREFIX):
+        raise AvatarsimError(f"--unit applies to motion files; {motion} is in metres already")
+
+
 def user_errors(fn: Callable[..., Any]) -> Callable[..., Any]:
     """Turn avatarsim's typed errors into a one-line reason on stderr and exit code 2.
 
     Anything else is a bug, not bad input: it exits 3 (never 1, which means "a check failed"),
-    with the traceback when ``AVATARSIM_DEBUG=1``.
+    with the traceback when ``AVATARSIM_DEBUG=1``. Warnings (numpy's RuntimeWarnings...) are
+    held back: dropped when the command fails with a reason (which says what went wrong),
+    otherwise printed after it, one line each.
     """
 
     @functools.wraps(fn)
     def wrapper(*args: Any, **kwargs: Any) -> Any:
-        try:
-            return fn(*args, **kwargs)
-        except AvatarsimError as exc:
-            err_console.print(f"[bold red]error:[/] {exc}", highlight=False, soft_wrap=True)
-            raise typer.Exit(2) from None
-        except (typer.Exit, typer.Abort, KeyboardInterrupt):
-            raise
-        except Exception as exc:
-            if os.environ.get("AVATARSIM_DEBUG") == "1":
+        with warnings.catch_warnings(record=True) as caught, _terminate_as_exit():
+            warnings.simplefilter("default")
+            try:
+                _check_common(kwargs)
+                result = fn(*args, **kwargs)
+            except AvatarsimError as exc:
+                err_console.print(
+                    f"[bold red]error:[/] {_one_line(exc)}", highlight=False, soft_wrap=True
+                )
+                raise typer.Exit(2) from None
+            except (typer.Exit, typer.Abort, KeyboardInterrupt):
+                _show(caught)
                 raise
-            err_console.print(
-                f"[bold red]internal error:[/] {type(exc).__name__}: {exc} "
-                "(a bug in avatarsim; rerun with AVATARSIM_DEBUG=1 for the traceback)",
-                highlight=False,
-                soft_wrap=True,
-            )
-            raise typer.Exit(INTERNAL_ERROR) from None
+            except Exception as exc:
+                if os.environ.get("AVATARSIM_DEBUG") == "1":
+                    raise
+                if isinstance(exc, OSError) and exc.filename is not None:
+                    # The file system refused (a full disk, permissions changed meanwhile):
+                    # the user's environment, not a bug.
+                    err_console.print(
+                        f"[bold red]error:[/] {_one_line(exc.filename)}: "
+                        f"{_one_line(exc.strerror or exc)}",
+                        highlight=False,
+                        soft_wrap=True,
+                    )
+                    raise typer.Exit(2) from None
+                err_console.print(
+                    f"[bold red]internal error:[/] {type(exc).__name__}: {_one_line(exc)} "
+                    "(a bug in avatarsim; rerun with AVATARSIM_DEBUG=1 for the traceback)",
+                    highlight=False,
+                    soft_wrap=True,
+                )
+                raise typer.Exit(INTERNAL_ERROR) from None
+        _show(caught)
+        return result
 
     return wrapper
+
+
+def _terminated(signum: int, frame: Any) -> None:  # pragma: no cover - a signal
+    raise SystemExit(128 + signum)
+
+
+@contextlib.contextmanager
+def _terminate_as_exit() -> Iterator[None]:
+    """SIGTERM (``kill``, a CI timeout) raises SystemExit, which unwinds like an exception, so
+    half-written outputs are removed on the way out (as for Ctrl-C)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, _terminated)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _show(caught: list[warnings.WarningMessage]) -> None:
+    seen = set()
+    for w in caught:
+        line = f"{w.category.__name__}: {w.message}"
+        if line not in seen:
+            seen.add(line)
+            err_console.print(
+                f"[yellow]warning:[/] {_one_line(line)}", highlight=False, soft_wrap=True
+            )
+
+
+def check_outputs(
+    *,
+    json_out: Path | None = None,
+    out: Path | None = None,
+    out_owner: str | None = None,
+    export: Path | None = None,
+    files: dict[str, Path | None] | None = None,
+) -> None:
+    """Every output path of a command, checked before any work starts (nothing is written):
+    ``--json`` (a file), ``--out`` (a folder; with ``out_owner`` one that the command
+    replaces whole, see :func:`scripts.results.atomic_dir`), ``--export`` (a folder) and
+    other ``files`` by option name. Bad paths raise :class:`AvatarsimError` (exit 2)."""
+    from scripts.results import check_output_dir, check_output_file
+
+    check_output_file(json_out, "--json")
+    for option, path in (files or {}).items():
+        check_output_file(path, option)
+    check_output_dir(out, "--out", out_owner)
+    check_output_dir(export, "--export")
+    if out is not None and out_owner is not None:
+        root = Path(out).absolute()
+        for option, path in [("--json", json_out), *(files or {}).items()]:
+            if path is not None and root in Path(path).absolute().parents:
+                raise AvatarsimError(
+                    f"{option} {path} is inside --out {out}, which is replaced whole; "
+                    "write it elsewhere"
+                )
 
 
 def emit_json(path: Path | None, payload: dict[str, Any]) -> None:
@@ -85,9 +184,17 @@ def unit_option(unit: str | None) -> dict[str, Any]:
 BUILTIN_PREFIX = "builtin:"
 
 
-def load_motion_arg(arg: str, unit: str | None = None, seed: int = 0, duration_s: float = 4.0):
+def load_motion_arg(
+    arg: str,
+    unit: str | None = None,
+    seed: int = 0,
+    duration_s: float = 4.0,
+    min_frames: int = 1,
+    check_height: bool = True,
+):
     """A motion file path, or ``builtin:ACTIVITY`` for the built-in generator (any command
-    that takes a MOTION accepts both)."""
+    that takes a MOTION accepts both). A clip shorter than ``min_frames`` frames or (with
+    ``check_height``) a body of no person's height is bad input."""
     if arg.startswith(BUILTIN_PREFIX):
         from avatar_models.generator import ACTIVITIES, generate
 
@@ -96,7 +203,21 @@ def load_motion_arg(arg: str, unit: str | None = None, seed: int = 0, duration_s
             raise AvatarsimError(
                 f"unknown built-in activity {activity!r}; built-in: {', '.join(ACTIVITIES)}"
             )
+        if unit is not None:
+            raise AvatarsimError(f"--unit applies to motion files; {arg} is in metres already")
         return generate(activity, duration_s=duration_s, seed=seed)
     from avatar_models.formats import load_motion
+    from avatar_models.measure import check_plausible_height
 
-    return load_motion(Path(arg), **unit_option(unit))
+    m = load_motion(Path(arg), **unit_option(unit))
+    if m.n_frames < min_frames:
+        raise MotionValueError(
+            f"{arg}: too short: {m.n_frames} frame(s); this command needs at least "
+            f"{min_frames} (velocities and accelerations)"
+        )
+    if check_height:
+        try:
+            check_plausible_height(m)
+        except MotionValueError as exc:
+            raise MotionValueError(f"{arg}: {exc}") from None
+    return m

@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import Any
 
 from rich.console import Console
+from rich.markup import escape
 
 from scripts.report_html import render_report
 from scripts.results import (
@@ -64,7 +65,7 @@ def run_scenario(
     """Run every stage, evaluate thresholds, write results.json and junit.xml into ``out_dir``."""
     validate(scenario)
     console = console or Console(stderr=True)
-    with atomic_dir(out_dir) as partial:
+    with atomic_dir(out_dir, "run") as partial:
         return _run_stages(scenario, partial, console)
 
 
@@ -75,7 +76,7 @@ def _run_stages(scenario: Scenario, out_dir: Path, console: Console) -> dict[str
     for stage in STAGES:
         name = stage.__name__.rsplit(".", 1)[-1]
         t0 = time.perf_counter()
-        with console.status(f"[bold]{scenario.name}[/]: {name}"):
+        with console.status(f"[bold]{escape(scenario.name)}[/]: {name}"):
             stage.run(ctx)
         timings[name] = round(time.perf_counter() - t0, 3)
         console.log(f"{name} done in {timings[name]:.2f} s")

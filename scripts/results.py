@@ -18,6 +18,8 @@ from typing import Any
 
 import numpy as np
 
+from avatar_models.errors import AvatarsimError
+from avatar_models.fileio import atomic_file, dir_mode
 from scripts.scenario import Threshold
 
 
@@ -53,37 +55,172 @@ def versions() -> dict[str, str]:
     return out
 
 
+OUTPUT_MARKER = ".avatarsim-output.json"
+
+
+def _nearest_existing(path: Path) -> Path:
+    """``path`` or its closest ancestor that exists."""
+    path = Path(os.path.abspath(path))
+    while not path.exists() and path != path.parent:
+        path = path.parent
+    return path
+
+
+def _probe_writable(folder: Path, option: str, path: Path) -> None:
+    """Create and remove a temporary folder in ``folder``: the only test of writability that
+    also holds for root, read-only mounts and full disks."""
+    try:
+        probe = tempfile.mkdtemp(dir=folder, prefix=".avatarsim-probe-")
+    except OSError as exc:
+        raise AvatarsimError(
+            f"{option} {path}: cannot write in {folder} ({exc.strerror or exc})"
+        ) from None
+    os.rmdir(probe)
+
+
+def _check_ancestors(path: Path, option: str) -> Path:
+    """The nearest existing ancestor of ``path``; an error if it is not a folder."""
+    existing = _nearest_existing(path.parent)
+    if not existing.is_dir():
+        raise AvatarsimError(f"{option} {path}: {existing} is a file, not a folder")
+    return existing
+
+
+def check_output_file(path: Path | None, option: str) -> None:
+    """Before any work: ``path`` can be written as a file (not a folder, not below a file,
+    in a writable folder). Writes nothing."""
+    if path is None:
+        return
+    path = Path(path)
+    if path.is_dir():
+        raise AvatarsimError(f"{option} {path} is a folder; give a file name")
+    if str(path).endswith(os.sep):
+        raise AvatarsimError(f"{option} {path} names a folder; give a file name")
+    _probe_writable(_check_ancestors(path, option), option, path)
+
+
+def check_output_dir(path: Path | None, option: str, owner: str | None = None) -> None:
+    """Before any work: ``path`` can be used as an output folder (not a file, not below a
+    file, writable). With ``owner`` (a command that replaces its folder whole, see
+    :func:`atomic_dir`), an existing non-empty folder must be a previous output of that
+    command holding only files it wrote. Writes nothing."""
+    if path is None:
+        return
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise AvatarsimError(f"{option} {path} is a file, not a folder")
+    existing = _check_ancestors(path, option)
+    # A folder written into must be writable; one replaced whole, its parent.
+    _probe_writable(path if owner is None and path.is_dir() else existing, option, path)
+    if owner is not None and path.is_dir():
+        _check_owned(path, option, owner)
+
+
+# More files than any output of ours holds: a folder with more is nobody's output of ours,
+# and is not walked further (``--out /`` answers at once).
+_MAX_FILES = 10_000
+
+
+def _files_in(folder: Path) -> set[str]:
+    """Entries below ``folder`` (relative paths), at most :data:`_MAX_FILES` + 1 of them:
+    files, links to folders and empty folders (none of which an output of ours has)."""
+    found: set[str] = set()
+    for root, dirs, files in os.walk(folder):
+        here = Path(root)
+        links = [d for d in dirs if (here / d).is_symlink()]
+        empty = [] if files or dirs or here == Path(folder) else [""]
+        for name in [*files, *links, *empty]:
+            found.add(str((here / name).relative_to(folder)))
+            if len(found) > _MAX_FILES:
+                return found
+    return found
+
+
+def _earlier_output(folder: Path, owner: str, present: set[str]) -> set[str]:
+    """The files of an output written before :data:`OUTPUT_MARKER` existed: ``track``'s
+    three files, or a run's folder (``results.json`` naming its outputs, whose folders hold
+    the rest). Empty when ``folder`` is not such an output."""
+    try:
+        if owner == "track":
+            names = {"tracking.csv", "tracking.json", "tracking.png"}
+            summary = json.loads((folder / "tracking.json").read_text(encoding="utf-8"))
+            return present if present <= names and "mode" in summary else set()
+        if owner == "run":
+            results = json.loads((folder / "results.json").read_text(encoding="utf-8"))
+            listed = {str(v) for v in results["outputs"].values()} | {"results.json"}
+            if not {"scenario", "versions"} <= set(results) or "junit.xml" not in listed:
+                return set()
+            tops = {Path(v).parts[0] for v in listed if len(Path(v).parts) > 1}
+            return {f for f in present if f in listed or Path(f).parts[0] in tops}
+    except (OSError, ValueError, KeyError, TypeError, AttributeError):
+        pass
+    return set()
+
+
+def _check_owned(folder: Path, option: str, owner: str) -> None:
+    """``folder`` is empty or a previous output of ``owner`` with nothing else in it."""
+    present = _files_in(folder)
+    if not present:
+        return
+    try:
+        marker = json.loads((folder / OUTPUT_MARKER).read_text(encoding="utf-8"))
+        command, files = str(marker["command"]), set(marker["files"])
+    except (OSError, ValueError, KeyError, TypeError):
+        command, files = None, _earlier_output(folder, owner, present)
+        command = owner if files else None
+    ours = files | {OUTPUT_MARKER} if command == owner else set()
+    # The user's own files first, hidden ones (a marker) last.
+    foreign = sorted(present - ours, key=lambda f: (Path(f).name.startswith("."), f))
+    if foreign:
+        whose = (
+            f" (it is an output of `avatarsim {command}`)" if command not in (None, owner) else ""
+        )
+        raise AvatarsimError(
+            f"{option} {folder} holds files not written by `avatarsim {owner}`{whose}, e.g. "
+            f"{foreign[0]!r}; it would be replaced whole, so choose a new or empty folder"
+        )
+
+
 @contextmanager
-def atomic_dir(final_dir: Path) -> Iterator[Path]:
+def atomic_dir(final_dir: Path, owner: str) -> Iterator[Path]:
     """A hidden sibling folder to write into; it replaces ``final_dir`` only when the block
-    completes, so a failed run never leaves half its outputs behind."""
+    completes, so a failed run never leaves half its outputs behind (nor the hidden folder).
+
+    ``final_dir`` is replaced whole, so it is only replaced when it is empty or a previous
+    output of ``owner`` (recorded in :data:`OUTPUT_MARKER` with the files written) holding
+    nothing else; otherwise :class:`AvatarsimError`, before anything is written. A user's file
+    is never deleted."""
     final_dir = Path(final_dir)
+    check_output_dir(final_dir, "--out", owner)
     final_dir.parent.mkdir(parents=True, exist_ok=True)
     out_dir = Path(tempfile.mkdtemp(dir=final_dir.parent, prefix=f".{final_dir.name}.partial-"))
     try:
         yield out_dir
+        write_json(out_dir / OUTPUT_MARKER, {"command": owner, "files": sorted(_files_in(out_dir))})
+        os.chmod(out_dir, dir_mode())
+        if final_dir.exists():
+            _check_owned(final_dir, "--out", owner)  # again: it may have changed meanwhile
+            old = Path(tempfile.mkdtemp(dir=final_dir.parent, prefix=f".{final_dir.name}.old-"))
+            try:
+                os.replace(final_dir, old / "x")
+                try:
+                    os.replace(out_dir, final_dir)
+                except BaseException:
+                    os.replace(old / "x", final_dir)  # the earlier output stays as it was
+                    raise
+            finally:
+                shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(out_dir, final_dir)
     except BaseException:
         shutil.rmtree(out_dir, ignore_errors=True)
         raise
-    if final_dir.exists():
-        shutil.rmtree(final_dir)
-    os.replace(out_dir, final_dir)
-    final_dir.chmod(0o755)
 
 
 def write_atomic(path: Path, data: bytes | str) -> Path:
     """Write to a temp file in the same folder, then rename: readers never see half a file."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data.encode("utf-8") if isinstance(data, str) else data)
-        os.chmod(tmp, 0o644)  # mkstemp makes it private; results are for sharing
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_file(path) as fh:
+        fh.write(data.encode("utf-8") if isinstance(data, str) else data)
     return path
 
 

@@ -35,8 +35,20 @@ from pathlib import Path
 from typing import Any
 
 from avatar_models.errors import AvatarsimError
+from avatar_models.motion import FPS_RANGE
 
 VR_NOISE = ("none", "realistic")
+
+# Bounds of a scenario's numbers (and the CLI's): beyond them a run is a typo that would
+# compute for hours or measure nothing.
+MIN_FRAMES = 3  # velocities need 2 frames, accelerations (residual forces, jitter) 3
+MAX_MOTION_S = 600.0  # seconds of motion a scenario runs on
+MAX_TRACK_S = 600.0  # seconds tracked under physics (the search runs slower than real time)
+MAX_PICTURE_FRAMES = 50  # frames in the report's strip
+GIF_FPS_RANGE = (1.0, 60.0)  # frame rates a GIF viewer plays
+MAX_STRIP_SPAN_S = 60.0
+MAX_DATABASE_SUBJECTS = 50
+MASS_RANGE_KG = (10.0, 300.0)
 
 
 class ScenarioError(AvatarsimError):
@@ -184,6 +196,10 @@ def _threshold(name: str, raw: Any) -> Threshold:
         bounds = [b for b in (t.min, t.max) if b is not None]
         if any(b != b or abs(b) == float("inf") for b in bounds):
             raise ScenarioError(f"thresholds.{name} bounds must be finite numbers")
+        if t.min is not None and t.max is not None and t.min > t.max:
+            raise ScenarioError(
+                f"thresholds.{name}: min {t.min:g} is above max {t.max:g}; nothing could pass"
+            )
         return t
     raise ScenarioError(f"thresholds.{name} must be a number (max) or a table {{min=, max=}}")
 
@@ -207,24 +223,57 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
             ("tracking", TrackingSpec),
         )
     }
-    if optional["tracking"] and not optional["tracking"].seconds > 0:
-        raise ScenarioError("tracking.seconds must be positive")
+    if optional["tracking"] and not 0 < optional["tracking"].seconds <= MAX_TRACK_S:
+        raise ScenarioError(f"tracking.seconds must be above 0 and at most {MAX_TRACK_S:g}")
     if optional["devices"] and optional["devices"].noise not in VR_NOISE:
         raise ScenarioError(f"devices.noise must be one of {VR_NOISE}")
     if optional["synthesis"] and not optional["devices"]:
         raise ScenarioError("[synthesis] needs a [devices] table (the VR stream it runs on)")
-    if optional["synthesis"] and optional["synthesis"].database_subjects < 1:
-        raise ScenarioError("synthesis.database_subjects must be at least 1")
-    if motion.duration_s <= 0 or motion.fps <= 0:
-        raise ScenarioError("motion.duration_s and motion.fps must be positive")
+    synthesis = optional["synthesis"]
+    if synthesis and not 1 <= synthesis.database_subjects <= MAX_DATABASE_SUBJECTS:
+        raise ScenarioError(
+            f"synthesis.database_subjects must be 1-{MAX_DATABASE_SUBJECTS}, "
+            f"got {synthesis.database_subjects}"
+        )
+    if synthesis and not 0 < synthesis.database_duration_s <= MAX_MOTION_S:
+        raise ScenarioError(
+            f"synthesis.database_duration_s must be above 0, at most {MAX_MOTION_S:g}"
+        )
+    if synthesis and not 0 <= synthesis.arm_ik <= 1:
+        raise ScenarioError(f"synthesis.arm_ik must be 0-1, got {synthesis.arm_ik}")
+    if not 0 < motion.duration_s <= MAX_MOTION_S:
+        raise ScenarioError(
+            f"motion.duration_s must be above 0 and at most {MAX_MOTION_S:g}, "
+            f"got {motion.duration_s}"
+        )
+    if motion.source == "builtin" and motion.unit is not None:
+        raise ScenarioError("motion.unit applies to motion files; built-in motion is in metres")
+    lo, hi = FPS_RANGE
+    if not lo <= motion.fps <= hi:
+        raise ScenarioError(f"motion.fps must be {lo:g}-{hi:g}, got {motion.fps}")
+    if motion.duration_s * motion.fps < MIN_FRAMES - 1:
+        raise ScenarioError(
+            f"motion.duration_s x motion.fps gives fewer than {MIN_FRAMES} frames: too short"
+        )
     if motion.height_m is not None and not 1.0 <= motion.height_m <= 2.5:
         raise ScenarioError(f"motion.height_m={motion.height_m} is not a human height in metres")
-    if body.mass_kg is not None and body.mass_kg <= 0:
-        raise ScenarioError("body.mass_kg must be positive")
-    if report.strip_span_s <= 0:
-        raise ScenarioError("report.strip_span_s must be positive")
-    if report.picture_frames < 1:
-        raise ScenarioError("report.picture_frames must be at least 1")
+    if body.height_m is not None and not 1.0 <= body.height_m <= 2.5:
+        raise ScenarioError(f"body.height_m={body.height_m} is not a human height in metres")
+    lo, hi = MASS_RANGE_KG
+    if body.mass_kg is not None and not lo <= body.mass_kg <= hi:
+        raise ScenarioError(f"body.mass_kg must be {lo:g}-{hi:g}, got {body.mass_kg}")
+    if not 0 < report.strip_span_s <= MAX_STRIP_SPAN_S:
+        raise ScenarioError(
+            f"report.strip_span_s must be above 0 and at most {MAX_STRIP_SPAN_S:g}, "
+            f"got {report.strip_span_s}"
+        )
+    if not 1 <= report.picture_frames <= MAX_PICTURE_FRAMES:
+        raise ScenarioError(
+            f"report.picture_frames must be 1-{MAX_PICTURE_FRAMES}, got {report.picture_frames}"
+        )
+    lo, hi = GIF_FPS_RANGE
+    if not lo <= report.gif_fps <= hi:
+        raise ScenarioError(f"report.gif_fps must be {lo:g}-{hi:g}, got {report.gif_fps}")
     thresholds_raw = data.get("thresholds", {})
     if not isinstance(thresholds_raw, dict):
         raise ScenarioError("[thresholds] must be a table")
@@ -232,9 +281,12 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
     physics = data.get("physics", {})
     if not isinstance(physics, dict):
         raise ScenarioError("[physics] must be a table of check settings")
+    seed = _check_type(data.get("seed", 0), int, "seed")
+    if seed < 0:
+        raise ScenarioError(f"seed must be 0 or more, got {seed}")
     return Scenario(
         name=_check_type(data.get("name", "scenario"), str, "name"),
-        seed=_check_type(data.get("seed", 0), int, "seed"),
+        seed=seed,
         motion=motion,
         body=body,
         report=report,

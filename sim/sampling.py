@@ -105,12 +105,16 @@ class SearchedTracking:
             plain controller's targets won), for :func:`replay`.
         window_steps: simulation steps per window.
         simulated_s: seconds simulated in all, samples included (the search's cost).
+        completed: whether the path reaches the reference's end; ``False`` when the search
+            gave up (every sample fell, retries and backtracks exhausted) and ``result`` is
+            the path that fell last, shorter than the reference.
     """
 
     result: TrackingResult
     offsets: np.ndarray
     window_steps: int
     simulated_s: float
+    completed: bool = True
 
 
 def state_cost(
@@ -230,12 +234,14 @@ def search_track(
             furthest, depth = len(history), 1
         bar.update(history[-1][0].progress.step - bar.n)
     bar.close()
-    best = history[-1][0] if tracker.finished(ref, history[-1][0].progress) else last_fallen
+    completed = tracker.finished(ref, history[-1][0].progress)
+    best = history[-1][0] if completed else last_fallen
     return SearchedTracking(
         result=tracker.result(ref, best.progress.frames),
         offsets=np.array(best.offsets).reshape(-1, m.nu),
         window_steps=window,
         simulated_s=simulated * m.opt.timestep,
+        completed=completed,
     )
 
 
@@ -263,13 +269,17 @@ def timed_tracking(
     """Track ``qpos_ref (T, nq)`` on (a copy of) ``model``: by :func:`search_track` with
     ``search``, or by the plain controller when it is ``None``. Returns the result and its
     summary (:meth:`TrackingResult.summary`) with the mode, the search's settings and
-    simulated seconds, the wall time and the speed next to real time."""
+    simulated seconds, the wall time and the speed next to real time, and the outcome:
+    ``requested_s`` (the reference's length), ``completed`` (tracked to its end without a
+    fall) and ``failure`` (``None``, ``"fell"``, or ``"search exhausted"`` when the search
+    gave up before the end: every sample fell within its look-ahead)."""
     start = time.perf_counter()
+    reached = True
     if search is None:
         result, extra = track(model, qpos_ref, fps), {"mode": "plain"}
     else:
         searched = search_track(model, qpos_ref, fps, search=search, progress_bar=progress_bar)
-        result = searched.result
+        result, reached = searched.result, searched.completed
         extra = {
             "mode": "search",
             "samples": search.samples,
@@ -277,5 +287,11 @@ def timed_tracking(
             "simulated_s": searched.simulated_s,
         }
     wall = time.perf_counter() - start
-    summary = result.summary() | extra | {"wall_s": wall}
+    failure = "fell" if result.fell else None if reached else "search exhausted"
+    outcome = {
+        "requested_s": qpos_ref.shape[0] / fps,
+        "completed": failure is None,
+        "failure": failure,
+    }
+    summary = result.summary() | extra | outcome | {"wall_s": wall}
     return result, summary | {"x_real_time": summary["duration_s"] / wall}

@@ -71,6 +71,7 @@ Load overrides from a dict or a TOML file (flat keys, the field names below)::
 
 from __future__ import annotations
 
+import math
 import tomllib
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass, fields, replace
@@ -78,6 +79,23 @@ from pathlib import Path
 from typing import Any
 
 from avatar_models.errors import AvatarsimError
+
+# Sane bounds of the definitions (low, high, must be > 0): beyond them a check measures
+# nothing meaningful (a 1 m "contact" height, a contact lasting 10 s). Thresholds only need
+# to be finite and >= 0.
+SETTING_RANGES: dict[str, tuple[float, float, bool]] = {
+    "contact_height_m": (0.0, 0.5, True),
+    "contact_vz_m_s": (0.0, 10.0, True),
+    "contact_min_s": (0.0, 2.0, False),
+    "contact_vxy_m_s": (0.0, 20.0, True),
+    "float_window_s": (0.0, 10.0, False),
+    "skate_speed_cm_s": (0.0, 1000.0, False),
+    "limit_tolerance_deg": (0.0, 180.0, False),
+    "limit_min_range_deg": (0.0, 360.0, False),
+    "self_collision_depth_cm": (0.0, 50.0, False),
+    "residual_cutoff_hz": (0.0, 500.0, True),
+    "friction": (0.0, 10.0, True),
+}
 
 
 class ConfigError(AvatarsimError):
@@ -123,6 +141,10 @@ class CheckConfig:
         for key, value in values.items():
             if isinstance(value, bool) or not isinstance(value, int | float) or not value >= 0:
                 raise ConfigError(f"check setting {key!r} must be a number >= 0, got {value!r}")
+            lo, hi, positive = SETTING_RANGES.get(key, (0.0, float("inf"), False))
+            if not math.isfinite(value) or not lo <= value <= hi or (positive and value == 0):
+                span = f"{'(' if positive else '['}{lo:g}, {hi:g}]"
+                raise ConfigError(f"check setting {key!r} must be in {span}, got {value!r}")
         return replace(cls(), **{k: float(v) for k, v in values.items()})
 
     @classmethod

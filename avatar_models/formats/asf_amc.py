@@ -566,7 +566,8 @@ def find_asf(amc_path: str | Path) -> Path:
             if candidate.is_file():
                 return candidate
     raise MotionFormatError(
-        f"no skeleton beside it (looked for {', '.join(s + '.asf' for s in stems)}); pass asf=",
+        f"no skeleton beside it: put its ASF file in the same folder, named "
+        f"{' or '.join(s + '.asf' for s in stems)} (from Python: read_asf_amc(path, asf=...))",
         amc_path,
     )
 

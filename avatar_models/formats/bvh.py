@@ -17,6 +17,11 @@ Reading gives a :class:`Motion` in metres, Z up, rest pose facing +X:
   unit that gives a human standing height (:func:`measure.standing_height`).
 - Axes: ``up="y"`` files are turned to Z up by ``C`` (:data:`units.Y_UP_TO_Z_UP`), positions
   ``p -> C p`` and rotations ``R -> C R C^T``; ``up="z"`` keeps the file's axes.
+- A prepended rest pose: the cgspeed BVH conversions of the CMU database put the T-pose
+  before the take as frame 0. Such a frame (:func:`prepended_rest_frame`: some joint turns
+  faster than a person can from it to frame 1, an order of magnitude more than between the
+  next frames, and it is much nearer the rest pose than frame 1) is dropped, and
+  ``meta["dropped_frames"]`` records it (``drop_rest_frame=False`` keeps it).
 
 The MOTION block is parsed in one vectorised pass (``np.loadtxt``'s C parser for plain
 decimal data; otherwise one ``np.fromstring`` plus a byte-level count of values per line) and
@@ -28,9 +33,7 @@ the file and line.
 from __future__ import annotations
 
 import io
-import os
 import re
-import tempfile
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,9 +43,10 @@ from scipy.spatial.transform import Rotation
 
 from avatar_models import quat
 from avatar_models.errors import MotionFormatError, MotionValueError
+from avatar_models.fileio import atomic_file
 from avatar_models.formats.units import Y_UP_TO_Z_UP, detect_unit, unit_scale
 from avatar_models.measure import standing_height
-from avatar_models.motion import Motion
+from avatar_models.motion import FPS_RANGE, Motion
 from avatar_models.skeleton import Skeleton
 
 _CHANNELS = {f"{a}{kind}": (kind, a) for a in "XYZ" for kind in ("position", "rotation")}
@@ -52,6 +56,10 @@ _MOTION_LINE = re.compile(r"^[ \t]*MOTION[ \t\r]*$", re.MULTILINE)
 _CONSTANT_RTOL = 1e-6
 # Bytes of frame data that the np.loadtxt fast path reads exactly as the checked path does.
 _DECIMAL_BYTES = b"0123456789.+-eE \t\r\n"
+# A whole-body turn rate (rad/s, mean over the joints) no person reaches: the joints of a
+# single limb peak near 20-40 rad/s in a throw, the mean over the body stays far lower (real
+# Bandai takes: at most 2). The cgspeed CMU T-pose frames jump at 28-54.
+_MAX_MEAN_JOINT_SPEED_RAD_S = 10.0
 
 
 @dataclass
@@ -211,6 +219,14 @@ def _motion_header(
     if not (np.isfinite(frame_time) and frame_time > 0):
         raise MotionFormatError(
             f"expected 'Frame Time: SECONDS' (positive), found {' '.join(tokens)!r}", path, line
+        )
+    lo, hi = 1.0 / FPS_RANGE[1], 1.0 / FPS_RANGE[0]
+    if not lo <= frame_time <= hi:
+        raise MotionFormatError(
+            f"Frame Time {tokens[2]} s is not a mocap frame time ({lo:g}-{hi:g} s, i.e. "
+            f"{FPS_RANGE[0]:g}-{FPS_RANGE[1]:g} fps)",
+            path,
+            line,
         )
     return frames, frame_time, start, line + 1
 
@@ -407,13 +423,48 @@ def _root_and_offsets(
     return root_pos, offsets, folded
 
 
+def _angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Rotation angle (rad) between unit quaternions ``a`` and ``b`` (same shape ``(..., 4)``)."""
+    return 2.0 * np.arccos(np.clip(np.abs(np.sum(a * b, axis=-1)), 0.0, 1.0))
+
+
+def prepended_rest_frame(rot: np.ndarray, fps: float) -> str | None:
+    """Why frame 0 of local rotations ``rot (T, J, 4)`` is a rest pose put before the take
+    (the cgspeed CMU conversions' T-pose), or ``None`` when it looks like part of the take.
+
+    All three must hold (angles are means over the joints): from frame 0 to 1 the joints
+    turn faster than :data:`_MAX_MEAN_JOINT_SPEED_RAD_S`; that turn is over 5 times the
+    largest frame-to-frame turn of the next half second; and frame 0 is less than half as far
+    from the rest pose as frame 1. The CMU clips in ``shared/mocap`` give ratios of 10-200,
+    Bandai's (no prepended frame) turn 100 times slower."""
+    n = rot.shape[0]
+    if n < 3:
+        return None
+    jump = float(_angle(rot[0], rot[1]).mean())
+    ahead = rot[1 : min(n, 2 + int(0.5 * fps))]
+    steady = float(_angle(ahead[:-1], ahead[1:]).mean(axis=-1).max())
+    rest = np.array([1.0, 0.0, 0.0, 0.0])
+    rest0, rest1 = (float(_angle(rot[i], rest).mean()) for i in (0, 1))
+    if jump * fps > _MAX_MEAN_JOINT_SPEED_RAD_S and jump > 5.0 * steady and rest0 < 0.5 * rest1:
+        return (
+            f"a rest pose before the take (the joints turn {np.degrees(jump):.0f} deg on "
+            f"average from it to the next frame, in {1000.0 / fps:.1f} ms)"
+        )
+    return None
+
+
 def _snap_fps(frame_time: float) -> float:
     """``1 / frame_time``, rounded to an integer when the file printed it to ~6 digits."""
     fps = 1.0 / frame_time
     return float(round(fps)) if abs(fps - round(fps)) < 1e-5 * fps else fps
 
 
-def read_bvh(path: str | Path, unit: str | float | None = None, up: str = "y") -> Motion:
+def read_bvh(
+    path: str | Path,
+    unit: str | float | None = None,
+    up: str = "y",
+    drop_rest_frame: bool = True,
+) -> Motion:
     """Read a BVH file into a :class:`Motion` (metres, Z up). See the module docstring.
 
     Args:
@@ -421,6 +472,7 @@ def read_bvh(path: str | Path, unit: str | float | None = None, up: str = "y") -
         unit: ``"m"``, ``"cm"``, ``"mm"``, ``"inch"``, ``"cmu"`` or metres per unit; ``None``
             guesses from the skeleton's standing height.
         up: ``"y"`` (the BVH convention) or ``"z"`` for files already Z up.
+        drop_rest_frame: drop a rest pose put before the take as frame 0 (module docstring).
     """
     path = Path(path)
     if up not in ("y", "z"):
@@ -469,6 +521,10 @@ def read_bvh(path: str | Path, unit: str | float | None = None, up: str = "y") -
         }
         if folded:
             meta["folded_root_into"] = folded
+        reason = prepended_rest_frame(rot, _snap_fps(frame_time)) if drop_rest_frame else None
+        if reason is not None:
+            meta["dropped_frames"] = {"frames": [0], "reason": reason}
+            root_pos, rot = root_pos[1:], rot[1:]
         return Motion(
             skeleton.scaled(scale),
             _snap_fps(frame_time),
@@ -559,14 +615,7 @@ def write_bvh(
     )
     header = _hierarchy_text(sk, sk.offsets @ axes.T / scale, joints, order)
     header += f"MOTION\nFrames: {motion.n_frames}\nFrame Time: {1.0 / motion.fps:.10g}\n"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(header)
-            np.savetxt(fh, data, fmt="%.10g", delimiter=" ")
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_file(path, "w", encoding="utf-8") as fh:
+        fh.write(header)
+        np.savetxt(fh, data, fmt="%.10g", delimiter=" ")
     return path

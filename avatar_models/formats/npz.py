@@ -9,14 +9,13 @@ Everything is stored in float64, so write -> read is exact.
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 import zipfile
 from pathlib import Path
 
 import numpy as np
 
 from avatar_models.errors import MotionFormatError, MotionValueError
+from avatar_models.fileio import atomic_file
 from avatar_models.motion import Motion
 from avatar_models.skeleton import Skeleton
 
@@ -44,15 +43,8 @@ def write_npz(motion: Motion, path: str | Path) -> Path:
         "skeleton_json": np.array(json.dumps(skeleton_json)),
         "meta_json": np.array(json.dumps(motion.meta, default=str)),
     }
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            np.savez_compressed(fh, **arrays)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_file(path) as fh:
+        np.savez_compressed(fh, **arrays)
     return path
 
 
@@ -70,6 +62,11 @@ def read_npz(path: str | Path) -> Motion:
             raise MotionFormatError(f"unsupported NPZ format version {version}", path)
         extra = json.loads(str(arrays["skeleton_json"]))
         meta = json.loads(str(arrays["meta_json"]))
+        for key, value in (("skeleton_json", extra), ("meta_json", meta)):
+            if not isinstance(value, dict):
+                raise MotionFormatError(
+                    f"{key} must be a JSON object, got a {type(value).__name__}", path
+                )
         limits = {
             j: {a: (float(lo), float(hi)) for a, (lo, hi) in ax.items()}
             for j, ax in extra.get("limits", {}).items()

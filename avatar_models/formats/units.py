@@ -44,9 +44,13 @@ def unit_scale(unit: str | float, path: object = None) -> float:
 def detect_unit(height_in_units: float, path: object = None) -> tuple[str, float]:
     """The named unit that makes ``height_in_units`` a human height, nearest to 1.7 m.
 
-    Raises :class:`MotionFormatError` (asking for ``unit=``) when no unit gives 1.0-2.5 m.
+    Raises :class:`MotionFormatError` (asking for ``--unit``) when no unit gives 1.0-2.5 m.
     """
     lo, hi = HUMAN_HEIGHT_M
+    if not (np.isfinite(height_in_units) and height_in_units > 0):
+        raise MotionFormatError(
+            "the skeleton has no size (its bones are all zero length), so no unit fits", path
+        )
     fits = [
         (abs(np.log(height_in_units * s / TYPICAL_HEIGHT_M)), name, s)
         for name, s in UNITS.items()
@@ -55,7 +59,8 @@ def detect_unit(height_in_units: float, path: object = None) -> tuple[str, float
     if not fits:
         raise MotionFormatError(
             f"cannot guess the length unit: the skeleton is {height_in_units:.4g} units tall and "
-            f"no unit ({', '.join(UNITS)}) makes that {lo}-{hi} m; pass unit= explicitly",
+            f"no unit ({', '.join(UNITS)}) makes that {lo}-{hi} m; give the unit with --unit "
+            "(a name or metres per unit; from Python: unit=)",
             path,
         )
     _, name, scale = min(fits)

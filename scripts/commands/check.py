@@ -12,9 +12,19 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 from rich.table import Table
 
-from scripts.cli_common import JsonOpt, SeedOpt, console, emit_json, load_motion_arg, user_errors
+from scripts.cli_common import (
+    MIN_FRAMES,
+    JsonOpt,
+    SeedOpt,
+    check_outputs,
+    console,
+    emit_json,
+    load_motion_arg,
+    user_errors,
+)
 
 
 def register(app: typer.Typer) -> None:
@@ -39,17 +49,18 @@ def register(app: typer.Typer) -> None:
         json_out: JsonOpt = None,
     ) -> None:
         """Physics plausibility of a motion on the MuJoCo humanoid. Exit 1 if a check fails."""
+        check_outputs(json_out=json_out, out=out, export=export)
         from sim.humanoid import humanoid_for
         from sim.plausibility import check_humanoid
         from sim.report import summary_rows, write_outputs
         from sim.thresholds import CheckConfig
 
         cfg = CheckConfig.from_toml(config) if config is not None else CheckConfig()
-        m = load_motion_arg(motion, unit, seed)
+        m = load_motion_arg(motion, unit, seed, min_frames=MIN_FRAMES)
         humanoid = humanoid_for(m)
         report = check_humanoid(humanoid, cfg)
         report.meta.update(path=str(motion), seed=seed)
-        table = Table(title=f"physics plausibility: {motion}")
+        table = Table(title=f"physics plausibility: {escape(motion)}")
         for col in ("check", "value", "threshold", "passed"):
             table.add_column(col)
         for name, value, limit, ok in summary_rows(report):
@@ -63,10 +74,12 @@ def register(app: typer.Typer) -> None:
 
             export_replay(humanoid, humanoid.qpos, m.fps, export)
             console.print(
-                f"MuJoCo viewer files in {export}/ (python -m mujoco.viewer --mjcf "
-                f"{export}/replay.xml)"
+                escape(
+                    f"MuJoCo viewer files in {export}/ (python -m mujoco.viewer --mjcf "
+                    f"{export}/replay.xml)"
+                )
             )
-        console.print(f"wrote {', '.join(str(p) for p in written.values())}")
+        console.print(escape(f"wrote {', '.join(str(p) for p in written.values())}"))
         emit_json(json_out, report.contract())
         if not report.passed:
             raise typer.Exit(1)

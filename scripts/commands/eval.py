@@ -12,10 +12,19 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 from rich.progress import Progress
 from rich.table import Table
 
-from scripts.cli_common import JsonOpt, SeedOpt, console, emit_json, err_console, user_errors
+from scripts.cli_common import (
+    JsonOpt,
+    SeedOpt,
+    check_outputs,
+    console,
+    emit_json,
+    err_console,
+    user_errors,
+)
 
 
 def _table(results: dict) -> Table:
@@ -35,7 +44,9 @@ def _table(results: dict) -> Table:
         ]
         corr = f"{s['hand_corr']['left']:.3f}/{s['hand_corr']['right']:.3f}"
         fps = f"{s['frames_per_s']:.0f} ({s['baseline_frames_per_s']:.0f})"
-        table.add_row(name, str(s["trials"]), *cells, corr, fps, end_section=name == "overall")
+        table.add_row(
+            escape(name), str(s["trials"]), *cells, corr, fps, end_section=name == "overall"
+        )
     return table
 
 
@@ -85,6 +96,17 @@ def register(app: typer.Typer) -> None:
         )
         from synthesis.report_plots import write_plots
 
+        for option, value, lo, hi in (
+            ("--subjects", subjects, 1, 50),
+            ("--takes", takes, 1, 20),
+            ("--duration", duration, 0.5, 600.0),
+            ("--heading", heading, 0.0, 180.0),
+            ("--db-headings", db_headings, 1, 36),
+            ("--max-per-class", 1 if max_per_class is None else max_per_class, 1, 100_000),
+        ):
+            if not lo <= value <= hi:  # also NaN
+                raise EvaluationError(f"{option} must be {lo:g}-{hi:g}, got {value}")
+        check_outputs(json_out=json_out, out=out)
         if method not in METHODS:
             raise EvaluationError(f"unknown method {method!r}; available: {', '.join(METHODS)}")
         if protocol not in PROTOCOLS:
@@ -108,7 +130,7 @@ def register(app: typer.Typer) -> None:
             task = bar.add_task(f"{method} {protocol}", total=None)
 
             def progress(done: int, total: int, label: str) -> None:
-                bar.update(task, completed=done, total=total, description=label)
+                bar.update(task, completed=done, total=total, description=escape(label))
 
             results = run_protocol(
                 trials,
@@ -131,10 +153,11 @@ def register(app: typer.Typer) -> None:
                 + "  (paper cross-subject: 16.5 -> 13.2 -> 11.4)"
             )
         for cls, reason in results["skipped"].items():
-            console.print(f"[yellow]skipped[/] {cls}: {reason}")
+            console.print(f"[yellow]skipped[/] {escape(cls)}: {escape(str(reason))}")
         for fail in results["failed_folds"]:
             console.print(
-                f"[yellow]fold failed[/] {fail['class']}/{fail['held_out']}: {fail['reason']}"
+                "[yellow]fold failed[/] "
+                + escape(f"{fail['class']}/{fail['held_out']}: {fail['reason']}")
             )
         results["plots"] = write_plots(results, out)
         emit_json(out / "eval.json", results)

@@ -17,11 +17,22 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 
-from scripts.cli_common import JsonOpt, SeedOpt, console, emit_json, load_motion_arg, user_errors
+from scripts.cli_common import (
+    JsonOpt,
+    SeedOpt,
+    check_outputs,
+    console,
+    emit_json,
+    load_motion_arg,
+    user_errors,
+)
 
 DEVICES = ("fisheye", "kinect-v2", "azure-kinect", "azure-kinect-wfov-binned")
 DEFAULT_DURATION_S = 2.0
+MAX_DURATION_S = 600.0  # seconds of motion rendered (about 30 frames per second of it)
+SIZE_RANGE = (16, 4096)  # fisheye image side in pixels
 FISHEYE_OPTIONS = (
     "--fov",
     "--size",
@@ -151,7 +162,11 @@ def register(app: typer.Typer) -> None:
             str | None, typer.Option(help="fisheye: field of view 'H,V' in degrees (150,120).")
         ] = None,
         size: Annotated[
-            str | None, typer.Option(help="fisheye: image size 'W,H' in pixels (640,480).")
+            str | None,
+            typer.Option(
+                help=f"fisheye: image size 'W,H' in pixels (640,480; {SIZE_RANGE[0]}-"
+                f"{SIZE_RANGE[1]} each)."
+            ),
         ] = None,
         ring_offset: Annotated[
             str | None,
@@ -225,17 +240,28 @@ def register(app: typer.Typer) -> None:
         )
         if duration_s is not None and end is not None:
             raise AvatarsimError("give --end or --duration-s, not both")
-        if duration_s is not None and not (math.isfinite(duration_s) and duration_s > 0):
-            raise AvatarsimError(f"--duration-s must be positive, got {duration_s}")
+        if duration_s is not None and not 0 < duration_s <= MAX_DURATION_S:
+            raise AvatarsimError(
+                f"--duration-s must be above 0 and at most {MAX_DURATION_S:g}, got {duration_s}"
+            )
         end_at = _parse_range(start, end)
+        if isinstance(end_at, float) and end_at - start > MAX_DURATION_S:
+            raise AvatarsimError(f"--start to --end spans more than {MAX_DURATION_S:g} s")
         # Every device option is checked before the motion is loaded and retargeted.
         if device == "fisheye":
             from render_cams.fisheye.model import FisheyeModel
             from render_cams.fisheye.rig import Mount
 
-            model = FisheyeModel.from_fov(
-                *_pair(fov, "--fov", (150, 120)), *_pair(size, "--size", (640, 480), int)
-            )
+            fov_deg = _pair(fov, "--fov", (150, 120))
+            size_px = _pair(size, "--size", (640, 480), int)
+            if not all(0 < v < 180 for v in fov_deg):
+                raise AvatarsimError(
+                    f"--fov: a FOV must be two angles in (0, 180) degrees, got {fov!r}"
+                )
+            lo, hi = SIZE_RANGE
+            if not all(lo <= v <= hi for v in size_px):
+                raise AvatarsimError(f"--size must be two sides of {lo}-{hi} pixels, got {size!r}")
+            model = FisheyeModel.from_fov(*fov_deg, *size_px)
             default = Mount()
             mount = Mount(
                 ring_offset_m=_numbers(ring_offset, "--ring-offset", 3) or default.ring_offset_m,
@@ -265,6 +291,7 @@ def register(app: typer.Typer) -> None:
             elif look_xyz is not None:
                 pose = look_at(pos_xyz, look_xyz)
 
+        check_outputs(json_out=json_out, out=out)
         # A built-in motion is generated long enough for the range asked.
         generate_s = end_at if isinstance(end_at, float) else None
         generate_s = generate_s or start + (duration_s or DEFAULT_DURATION_S)
@@ -305,7 +332,9 @@ def register(app: typer.Typer) -> None:
         summary.setdefault("fps_rendered", summary.get("frames", 0) / max(elapsed, 1e-9))
         summary["start_s"], summary["end_s"] = round(start_s, 6), round(end_s, 6)
         console.print(
-            f"{device}: {summary.get('frames')} frames ({start_s:.2f}-{end_s:.2f} s) in "
-            f"{elapsed:.1f} s ({summary['fps_rendered']:.1f} frames/s) -> {out}/"
+            escape(
+                f"{device}: {summary.get('frames')} frames ({start_s:.2f}-{end_s:.2f} s) in "
+                f"{elapsed:.1f} s ({summary['fps_rendered']:.1f} frames/s) -> {out}/"
+            )
         )
         emit_json(json_out, {"device": device, "out_dir": str(out), **summary})

@@ -6,7 +6,8 @@ about 10x real time, lasts a few steps on a walk). A clip shorter than ``--secon
 looped on its best gait cycle (``sim.tracking.looped``); a foreign rig is retargeted with its
 stance feet levelled. Writes ``tracking.csv``, ``tracking.json``, ``tracking.png`` into
 ``--out`` (replaced only when the run completes), optionally the simulated motion for MuJoCo's
-viewer into ``--export``. Exit 1 when the humanoid falls, 2 for bad input.
+viewer into ``--export``. Exit 1 when the humanoid falls or the search gives up before the
+requested time (the reason is in the table and the JSON's ``failure``), 2 for bad input.
 """
 
 from __future__ import annotations
@@ -15,9 +16,23 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
+from rich.markup import escape
 from rich.table import Table
 
-from scripts.cli_common import JsonOpt, SeedOpt, console, emit_json, load_motion_arg, user_errors
+from scripts.cli_common import (
+    MIN_FRAMES,
+    JsonOpt,
+    SeedOpt,
+    check_outputs,
+    console,
+    emit_json,
+    err_console,
+    load_motion_arg,
+    user_errors,
+)
+from scripts.scenario import MAX_TRACK_S
+
+MAX_SEARCH = 64  # samples or beam: 64 x 64 simulations per window is hours per second
 
 
 def register(app: typer.Typer) -> None:
@@ -30,13 +45,20 @@ def register(app: typer.Typer) -> None:
         ],
         seconds: Annotated[
             float | None,
-            typer.Option(help="Length to track (s); loops a shorter clip. Default: the clip."),
+            typer.Option(
+                help=f"Length to track (s, at most {MAX_TRACK_S:g}); loops a shorter clip. "
+                "Default: the clip."
+            ),
         ] = None,
         plain: Annotated[
             bool, typer.Option("--plain", help="The controller alone, no sampling search.")
         ] = False,
-        samples: Annotated[int, typer.Option(help="Search: samples per kept state.")] = 8,
-        beam: Annotated[int, typer.Option(help="Search: states kept per window.")] = 6,
+        samples: Annotated[
+            int, typer.Option(help=f"Search: samples per kept state (1-{MAX_SEARCH}).")
+        ] = 8,
+        beam: Annotated[
+            int, typer.Option(help=f"Search: states kept per window (1-{MAX_SEARCH}).")
+        ] = 6,
         out: Annotated[Path, typer.Option(help="Folder for CSV, JSON and plot.")] = Path(
             "out/track"
         ),
@@ -47,19 +69,29 @@ def register(app: typer.Typer) -> None:
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
     ) -> None:
-        """Physics tracking of a motion by the MuJoCo humanoid. Exit 1 if it falls."""
+        """Physics tracking of a motion by the MuJoCo humanoid. Exit 1 if it falls or does not
+        reach the requested time."""
         from avatar_models.errors import MotionValueError
+
+        if seconds is not None and not 0 < seconds <= MAX_TRACK_S:
+            raise MotionValueError(
+                f"--seconds must be above 0 and at most {MAX_TRACK_S:g}, got {seconds}"
+            )
+        if not (1 <= samples <= MAX_SEARCH and 1 <= beam <= MAX_SEARCH):
+            raise MotionValueError(f"--samples and --beam must be 1-{MAX_SEARCH}")
+        check_outputs(json_out=json_out, out=out, out_owner="track", export=export)
         from scripts.results import atomic_dir
         from sim.humanoid import humanoid_for
         from sim.sampling import SearchSettings, timed_tracking
         from sim.tracking import looped
         from sim.tracking_report import write_outputs
 
-        if seconds is not None and not seconds > 0:
-            raise MotionValueError(f"--seconds must be positive, got {seconds}")
-        if samples < 1 or beam < 1:
-            raise MotionValueError("--samples and --beam must be at least 1")
-        m = load_motion_arg(motion, unit, seed, duration_s=seconds or 10.0)
+        m = load_motion_arg(motion, unit, seed, duration_s=seconds or 10.0, min_frames=MIN_FRAMES)
+        if seconds is None and m.duration_s > MAX_TRACK_S:
+            raise MotionValueError(
+                f"the clip is {m.duration_s:.0f} s long; at most {MAX_TRACK_S:g} s are tracked "
+                "(pass --seconds)"
+            )
         humanoid = humanoid_for(m, level_feet=True)
         qpos = humanoid.qpos
         if seconds is not None:
@@ -70,12 +102,15 @@ def register(app: typer.Typer) -> None:
         result, summary = timed_tracking(humanoid.model, qpos, m.fps, search, progress_bar=True)
         summary |= summary_extra
         wall = summary["wall_s"]
-        table = Table(title=f"physics tracking ({summary['mode']}): {motion}")
+        table = Table(title=f"physics tracking ({summary['mode']}): {escape(motion)}")
         for col in ("quantity", "value"):
             table.add_column(col)
         fell = "never" if not result.fell else f"[red]at {result.fall_time_s:.2f} s[/]"
+        tracked = f"{summary['duration_s']:.2f} s of {summary['requested_s']:.2f} s"
+        outcome = "[green]completed[/]" if summary["completed"] else f"[red]{summary['failure']}[/]"
         rows = [
-            ("tracked", f"{summary['duration_s']:.2f} s"),
+            ("tracked", tracked),
+            ("outcome", outcome),
             ("fell", fell),
             (
                 "body17 error mean / p95",
@@ -88,17 +123,24 @@ def register(app: typer.Typer) -> None:
         for row in rows:
             table.add_row(*row)
         console.print(table)
-        with atomic_dir(out) as partial:
+        with atomic_dir(out, "track") as partial:
             written = write_outputs(result, summary, partial, f"physics tracking: {motion}")
-        console.print(f"wrote {', '.join(str(out / p.name) for p in written.values())}")
+        console.print(escape(f"wrote {', '.join(str(out / p.name) for p in written.values())}"))
         if export is not None:
             from sim.export import export_replay
 
             export_replay(humanoid, result.qpos, m.fps, export)
             console.print(
-                f"MuJoCo viewer files in {export}/ (python -m mujoco.viewer --mjcf "
-                f"{export}/replay.xml)"
+                escape(
+                    f"MuJoCo viewer files in {export}/ (python -m mujoco.viewer --mjcf "
+                    f"{export}/replay.xml)"
+                )
             )
         emit_json(json_out, summary)
-        if result.fell:
+        if not summary["completed"]:
+            err_console.print(
+                f"[red]not tracked to the end:[/] {summary['failure']} after "
+                f"{summary['duration_s']:.2f} s of {summary['requested_s']:.2f} s",
+                highlight=False,
+            )
             raise typer.Exit(1)

@@ -6,10 +6,12 @@ import dataclasses
 
 import numpy as np
 
+from avatar_models.errors import MotionValueError
 from avatar_models.formats import load_motion, save_motion
 from avatar_models.generator import ACTIVITIES, generate, sample_subject
+from avatar_models.measure import check_plausible_height
 from scripts.run_context import RunContext
-from scripts.scenario import ScenarioError
+from scripts.scenario import MIN_FRAMES, ScenarioError
 
 METRICS = {"frames": "number of motion frames"}
 
@@ -33,6 +35,15 @@ def run(ctx: RunContext) -> None:
         if abs(motion.fps - spec.fps) > 1e-9:
             motion = motion.resample(spec.fps)
         motion = motion[: max(1, int(round(spec.duration_s * motion.fps)) + 1)]
+        if motion.n_frames < MIN_FRAMES:
+            raise ScenarioError(
+                f"motion {spec.source}: too short: {motion.n_frames} frame(s); a run needs at "
+                f"least {MIN_FRAMES} (velocities and accelerations)"
+            )
+        try:
+            check_plausible_height(motion)
+        except MotionValueError as exc:
+            raise ScenarioError(f"motion {spec.source}: {exc} (motion.unit)") from None
     ctx.motion = motion
     ctx.metrics["frames"] = float(motion.n_frames)
     ctx.info["motion"] = {

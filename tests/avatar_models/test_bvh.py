@@ -203,7 +203,7 @@ def test_unit_is_detected_from_standing_height(tmp_path, height, unit):
 
 
 def test_implausible_size_asks_for_unit(tmp_path):
-    with pytest.raises(MotionFormatError, match="pass unit="):
+    with pytest.raises(MotionFormatError, match="give the unit with --unit"):
         read_bvh(write_text(tmp_path, _upright_chain(7.0)))
 
 

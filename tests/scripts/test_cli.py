@@ -91,7 +91,7 @@ def test_convert_to_an_unwritable_place_exits_2(tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("x")
     result = runner.invoke(app, ["convert", str(npz), str(blocker / "sub" / "out.bvh")])
-    assert result.exit_code == 2 and "cannot write" in result.stderr
+    assert result.exit_code == 2 and "is a file, not a folder" in result.stderr
 
 
 def test_threshold_on_a_metric_the_scenario_does_not_produce_exits_2(tmp_path):

@@ -25,7 +25,8 @@ def test_track_searches_writes_outputs_and_exports(tmp_path):
     assert summary["mode"] == "search" and summary["fell"] is False
     assert summary["simulated_s"] >= 8 * 1.0  # every kept state is sampled 8 times
     assert json.loads((out / "tracking.json").read_text()) == summary
-    assert {p.name for p in out.iterdir()} == {"tracking.csv", "tracking.json", "tracking.png"}
+    written = {p.name for p in out.iterdir()}
+    assert written == {"tracking.csv", "tracking.json", "tracking.png", ".avatarsim-output.json"}
     rows = np.genfromtxt(out / "tracking.csv", delimiter=",", names=True)
     assert len(rows) == 91 and rows["fallen"].max() == 0  # 1 s at the generator's 90 fps
     assert abs(rows["body17_err_cm"].mean() - summary["body17_err_cm_mean"]) < 1e-6
@@ -53,3 +54,40 @@ def test_bad_input_exits_2_and_writes_nothing(tmp_path):
     result = runner.invoke(app, ["track", str(tmp_path / "missing.bvh"), "--out", str(out)])
     assert result.exit_code == 2
     assert not out.exists()
+
+
+def test_a_search_that_gives_up_before_the_end_exits_1_with_the_reason(tmp_path, monkeypatch):
+    """The search may give up (every sample falls within its look-ahead) before the requested
+    time without the body on the floor yet: that is no success (issue 9: "tracked 0.63 s,
+    fell never", exit 0)."""
+    import dataclasses
+
+    import sim.sampling as sampling
+
+    real = sampling.search_track
+
+    def gives_up(model, qpos_ref, fps, **kwargs):
+        searched = real(model, qpos_ref[: qpos_ref.shape[0] // 3], fps, **kwargs)
+        return dataclasses.replace(searched, completed=False)
+
+    monkeypatch.setattr(sampling, "search_track", gives_up)
+    out, js = tmp_path / "o", tmp_path / "r.json"
+    args = ["track", "builtin:walk", "--seconds", "0.6", "--samples", "2", "--beam", "1"]
+    result = runner.invoke(app, [*args, "--out", str(out), "--json", str(js)])
+    assert result.exit_code == 1, result.output
+    assert "search exhausted" in result.output and "of 0.6" in result.output
+    summary = json.loads(js.read_text())
+    assert summary["completed"] is False and summary["failure"] == "search exhausted"
+    assert summary["fell"] is False and summary["duration_s"] < summary["requested_s"]
+    assert json.loads((out / "tracking.json").read_text())["failure"] == "search exhausted"
+
+
+def test_a_completed_track_reports_no_failure(tmp_path):
+    motion = generate("walk", duration_s=0.3, fps=30.0)
+    path = save_motion(motion, tmp_path / "w.npz")
+    js = tmp_path / "r.json"
+    args = ["track", str(path), "--plain", "--out", str(tmp_path / "o"), "--json", str(js)]
+    result = runner.invoke(app, args)
+    summary = json.loads(js.read_text())
+    assert result.exit_code == (0 if summary["completed"] else 1), result.output
+    assert summary["failure"] in (None, "fell") and summary["requested_s"] == 10 / 30
