@@ -10,8 +10,9 @@ differential IK (a QP over the joint velocities, solved by daqp) to convergence:
     s.t. q within the model's joint ranges (``mink.ConfigurationLimit``)
 
 with Levenberg-Marquardt damping on the frame tasks, so unreachable targets pull the limb
-straight at them instead of making the step explode. The posture term excludes the free
-root. A trajectory is solved frame after frame, each warm-started from the previous
+straight at them instead of making the step explode, and a small damping ``d |dq|^2`` of
+every step (:attr:`IKSettings.damping`), without which the iteration does not converge and
+its output depends on BLAS rounding. The posture term excludes the free root. A trajectory is solved frame after frame, each warm-started from the previous
 solution (so consecutive solutions stay on one branch); the first frame starts from the
 posture with its root rigidly fitted to the targets (Kabsch), so a target set facing -X
 does not begin half a turn away.
@@ -47,6 +48,23 @@ class IKSettings:
     Attributes:
         posture_cost: weight of ``|q - q_posture|^2`` per hinge (radians), small so targets win.
         lm_damping: Levenberg-Marquardt damping of the frame tasks.
+        damping: ``d |dq|^2`` added to every QP step, on every coordinate (the free root's
+            too). It damps the step, not the solution (a converged ``q`` has ``dq = 0``).
+            Why it is needed: the posture term is the only curvature of directions that
+            move no steered frame (the pelvis hinges sit at the root's origin and duplicate
+            its rotation; spine and clavicle chains, forearm twist), ``posture_cost^2 =
+            1e-6``, against ``~170`` for the head target: the QP Hessian's condition number
+            was ~5e8 and the full Gauss-Newton step went 0.5-1 rad along those directions,
+            past where the linearisation holds, so the iteration oscillated between
+            configurations (the IK baseline never met the tolerance, 13 joint limits
+            switching) instead of converging. Such a map amplifies any difference: BLAS
+            rounding of ``J^T W J`` (a different OpenBLAS kernel sums in another order)
+            gave 7e-9 rad after the first frame and 1 rad 20 frames later, 41 cm of body17
+            position and 1.8 -> 2.5 cm of the IK baseline's hand error (OpenBLAS Haswell
+            vs Sandybridge kernels). With ``d = 1e-4`` (100x the posture curvature, at the
+            hands' orientation cost ``0.01^2``, below every position cost) weak directions
+            step at most ``|g| / d``, each iteration contracts, and the two kernels agree
+            to 1e-9 cm (``tests/avatar_models/test_body_ik.py``).
         max_iterations: QP steps per frame at most (the first frame gets ``4x`` as many).
         tolerance: stop a frame once a step moves no coordinate by more than this.
     """
@@ -55,6 +73,7 @@ class IKSettings:
     lm_damping: float = 1e-3
     max_iterations: int = 20
     tolerance: float = 1e-4
+    damping: float = 1e-4
 
 
 @dataclass(frozen=True)
@@ -199,7 +218,14 @@ class HumanoidIK:
         steps = max_iterations or self.settings.max_iterations
         it = 0
         for it in range(1, steps + 1):  # noqa: B007 - the count is returned
-            dq = mink.solve_ik(self.configuration, tasks, 1.0, SOLVER, limits=self.limits)
+            dq = mink.solve_ik(
+                self.configuration,
+                tasks,
+                1.0,
+                SOLVER,
+                damping=self.settings.damping,
+                limits=self.limits,
+            )
             self.configuration.integrate_inplace(dq, 1.0)
             if np.abs(dq).max() < self.settings.tolerance:
                 break
