@@ -13,9 +13,10 @@ with Levenberg-Marquardt damping on the frame tasks, so unreachable targets pull
 straight at them instead of making the step explode, and a small damping ``d |dq|^2`` of
 every step (:attr:`IKSettings.damping`), without which the iteration does not converge and
 its output depends on BLAS rounding. The posture term excludes the free root. A
-trajectory is solved frame after frame, each warm-started from the previous solution (so consecutive solutions stay on one branch); the first frame starts from the
-posture with its root rigidly fitted to the targets (Kabsch), so a target set facing -X
-does not begin half a turn away.
+trajectory is solved frame after frame, each warm-started from the previous solution
+(so consecutive solutions stay on one branch); the first frame starts from the posture
+with its root rigidly fitted to the targets (Kabsch), so a target set facing -X does not
+begin half a turn away.
 
 Both ``sim`` (retargeting) and ``synthesis`` (the head + hands baseline) use this module.
 """
