@@ -67,7 +67,7 @@ class IKSettings:
             1e-12 m of target noise still became 0.79 m); ``d = 1e-2`` (1e4 x the posture
             curvature, 1/100 of a unit position cost's) contracts there too (3e-12 m, mean
             residual 12.4 -> 3.7 cm), and the IK baseline then agrees across the two
-            kernels to 1e-10 cm with hand errors of 0.006 cm instead of 0.02-3.6 cm.
+            kernels to 1e-6 cm with hand errors of 0.006 cm instead of 0.02-3.6 cm.
         max_iterations: QP steps per frame at most (the first frame gets ``4x`` as many).
         tolerance: stop a frame once a step moves no coordinate by more than this.
     """
