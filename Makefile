@@ -3,20 +3,48 @@ PY ?= python3
 VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
+TORCH := 2.13.0
 OUT ?= out/demo
 
-.PHONY: demo test lint bench clean
+.PHONY: demo test lint bench clean lock
 
-$(STAMP): pyproject.toml constraints.txt
+# Every resolved version is pinned in requirements.lock (`make lock` refreshes it). The lock
+# is installed with --no-deps, so nothing outside it comes in, and `pip check` proves it is
+# complete and consistent before pyrender (whose own pins conflict, see below) goes in.
+$(STAMP): pyproject.toml constraints.txt requirements.lock
 	$(PY) -m venv $(VENV)
 	$(BIN)/pip install -q --upgrade pip
 	# torch first, pinned: the CPU build on local disk (a bare `torch` pulls CUDA).
-	$(BIN)/pip install -q torch==2.13.0
-	$(BIN)/pip install -q -c constraints.txt -e '.[test]'
+	$(BIN)/pip install -q torch==$(TORCH)
+	$(BIN)/pip install -q --no-deps -r requirements.lock
+	$(BIN)/pip install -q --no-deps -e .
+	$(BIN)/pip check
 	# pyrender pins PyOpenGL==3.1.0, which breaks mujoco's EGL: install it without deps
 	# (its other dependencies are in pyproject.toml, PyOpenGL>=3.1.7 among them).
 	$(BIN)/pip install -q --no-deps 'pyrender==0.1.45'
 	touch $(STAMP)
+
+# Re-resolve requirements.lock from pyproject.toml (+ the test extra) and constraints.txt.
+# Pins already in the lock are kept unless UPGRADE=1 (then every package takes its newest
+# allowed release). torch is held to the CPU build in $(WHEELS) (whose dependencies have no
+# nvidia-*/triton packages) and written as torch==$(TORCH), what the first install step puts in.
+UV_VERSION := 0.13.9
+WHEELS ?= /opt/wheels
+UPGRADE ?=
+$(BIN)/uv:
+	$(PY) -m venv $(VENV)
+	$(BIN)/pip install -q 'uv==$(UV_VERSION)'
+
+lock: $(BIN)/uv
+	echo 'torch==$(TORCH)+cpu' > $(VENV)/torch-cpu.txt
+	$(BIN)/uv pip compile pyproject.toml --extra test -c constraints.txt -c $(VENV)/torch-cpu.txt \
+		--python-version 3.11 --python-platform x86_64-manylinux_2_28 \
+		$(if $(wildcard $(WHEELS)),--find-links $(WHEELS)) $(if $(UPGRADE),--upgrade) \
+		--no-emit-find-links --custom-compile-command 'make lock' -q -o requirements.lock
+	sed -i -E 's/^torch==([^+ ]+)\+cpu/torch==\1/' requirements.lock
+	@if grep -q -i -E '^(nvidia-|triton)' requirements.lock; then \
+		echo "requirements.lock pulls CUDA packages: torch came from the index, not $(WHEELS)" >&2; \
+		exit 1; fi
 
 demo: $(STAMP)
 	$(BIN)/avatarsim demo --out $(OUT)

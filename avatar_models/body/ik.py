@@ -10,11 +10,13 @@ differential IK (a QP over the joint velocities, solved by daqp) to convergence:
     s.t. q within the model's joint ranges (``mink.ConfigurationLimit``)
 
 with Levenberg-Marquardt damping on the frame tasks, so unreachable targets pull the limb
-straight at them instead of making the step explode. The posture term excludes the free
-root. A trajectory is solved frame after frame, each warm-started from the previous
-solution (so consecutive solutions stay on one branch); the first frame starts from the
-posture with its root rigidly fitted to the targets (Kabsch), so a target set facing -X
-does not begin half a turn away.
+straight at them instead of making the step explode, and a small damping ``d |dq|^2`` of
+every step (:attr:`IKSettings.damping`), without which the iteration does not converge and
+its output depends on BLAS rounding. The posture term excludes the free root. A
+trajectory is solved frame after frame, each warm-started from the previous solution
+(so consecutive solutions stay on one branch); the first frame starts from the posture
+with its root rigidly fitted to the targets (Kabsch), so a target set facing -X does not
+begin half a turn away.
 
 Both ``sim`` (retargeting) and ``synthesis`` (the head + hands baseline) use this module.
 """
@@ -47,6 +49,25 @@ class IKSettings:
     Attributes:
         posture_cost: weight of ``|q - q_posture|^2`` per hinge (radians), small so targets win.
         lm_damping: Levenberg-Marquardt damping of the frame tasks.
+        damping: ``d |dq|^2`` added to every QP step, on every coordinate (the free root's
+            too). It damps the step, not the solution (a converged ``q`` has ``dq = 0``).
+            Why it is needed: the posture term is the only curvature of directions that
+            move no steered frame (the pelvis hinges sit at the root's origin and duplicate
+            its rotation; spine and clavicle chains, forearm twist), ``posture_cost^2 =
+            1e-6``, against ``~170`` for the IK baseline's head target: the QP Hessian's
+            condition number was ~5e8 and the full Gauss-Newton step went 0.5-1 rad along
+            those directions, past where the linearisation holds, so the iteration
+            oscillated (13 joint limits switching, never within the tolerance) instead of
+            converging. Such a map amplifies any difference ~3x per frame: BLAS rounding of
+            ``J^T W J`` (another OpenBLAS kernel sums in another order) gave 7e-9 rad after
+            the first frame and 1 rad 20 frames later: 41 cm of body17 position and 1.8 ->
+            2.5 cm of the IK baseline's mean hand error (OpenBLAS Haswell vs Sandybridge
+            kernels, builtin box, seed 2). ``d = 1e-4`` stopped that on reachable targets
+            but not on unreachable ones (a 1.95 m subject's targets on the 1.8 m avatar:
+            1e-12 m of target noise still became 0.79 m); ``d = 1e-2`` (1e4 x the posture
+            curvature, 1/100 of a unit position cost's) contracts there too (3e-12 m, mean
+            residual 12.4 -> 3.7 cm), and the IK baseline then agrees across the two
+            kernels to 1e-6 cm with hand errors of 0.006 cm instead of 0.02-3.6 cm.
         max_iterations: QP steps per frame at most (the first frame gets ``4x`` as many).
         tolerance: stop a frame once a step moves no coordinate by more than this.
     """
@@ -55,6 +76,7 @@ class IKSettings:
     lm_damping: float = 1e-3
     max_iterations: int = 20
     tolerance: float = 1e-4
+    damping: float = 1e-2
 
 
 @dataclass(frozen=True)
@@ -199,7 +221,14 @@ class HumanoidIK:
         steps = max_iterations or self.settings.max_iterations
         it = 0
         for it in range(1, steps + 1):  # noqa: B007 - the count is returned
-            dq = mink.solve_ik(self.configuration, tasks, 1.0, SOLVER, limits=self.limits)
+            dq = mink.solve_ik(
+                self.configuration,
+                tasks,
+                1.0,
+                SOLVER,
+                damping=self.settings.damping,
+                limits=self.limits,
+            )
             self.configuration.integrate_inplace(dq, 1.0)
             if np.abs(dq).max() < self.settings.tolerance:
                 break

@@ -101,8 +101,13 @@ def test_small_cross_subject_run_gives_the_contract_keys():
         assert set(summary["hand_corr"]) == {"left", "right"}
         assert summary["frames_per_s"] > 0
         assert all(np.isfinite(v) for v in summary["err_cm"].values())
-    # The IK baseline is driven to the tracked wrists: its hand error is small.
-    assert result["overall"]["baseline_err_cm"]["hands"] < 3.0
+    # The IK baseline is driven to the tracked wrists: its hand error is small. Measured
+    # (this call, OpenBLAS Haswell and Sandybridge kernels, identical across them): seeds 0-4
+    # 0.005-0.006 cm; seeds 0-9 with a 100x weaker step damping 0.001-0.012 cm. Threshold
+    # 0.1 cm: 8x the worst of those runs
+    # and still 10 x below what an IK that does not converge gives (1.65-2.5 cm on seeds 2
+    # and 4 before IKSettings.damping, 3.1 cm on an AVX-512 machine).
+    assert result["overall"]["baseline_err_cm"]["hands"] < 0.1
     with pytest.raises(EvaluationError, match="unknown method"):
         run_protocol(trials, "cross-subject", method="magic")
 

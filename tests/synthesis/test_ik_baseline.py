@@ -15,6 +15,10 @@ from synthesis.base import SynthesisError, TrackingFrame
 from synthesis.ik_baseline import IKBaseline, Stepper
 
 TRACKED = body17.group_indices(("head", "l_wrist", "r_wrist"))
+# THRESHOLDS of the tracked joints' error on noise-free targets, from the spread over seeds
+# 0-5 of dribble, run and swim (OpenBLAS Haswell and Sandybridge kernels, the same to 1e-12):
+# median 0.001-0.004 cm, 95th percentile 0.007-0.019 cm. 1 mm is 5x the worst p95; before
+# the IK's step damping these were up to 0.08 cm and 1.55 cm (the old limits: 1 and 2 cm).
 
 
 @pytest.fixture(scope="module")
@@ -37,8 +41,8 @@ def test_head_and_hands_reach_reachable_targets(dribble, dribble_output):
         axis=-1,
     )
     assert dribble_output.n_frames == motion.n_frames
-    assert np.median(err) < 0.01
-    assert np.percentile(err, 95) < 0.02
+    assert np.median(err) < 1e-3  # (THRESHOLDS)
+    assert np.percentile(err, 95) < 1e-3
 
 
 def test_joint_targets_undo_the_device_attachments(dribble):
@@ -119,8 +123,8 @@ def test_tracked_joints_stay_on_noise_free_targets_while_the_body_moves(activity
     err = np.linalg.norm(
         body17_positions(out)[:, TRACKED] - body17_positions(motion)[:, TRACKED], axis=-1
     )
-    assert np.median(err) < 0.01
-    assert np.percentile(err, 95) < 0.02
+    assert np.median(err) < 1e-3  # (THRESHOLDS)
+    assert np.percentile(err, 95) < 1e-3
 
 
 def test_face_down_head_lays_the_body_behind_it(dribble):
@@ -134,3 +138,18 @@ def test_face_down_head_lays_the_body_behind_it(dribble):
     assert not grounded
     assert pelvis[0] < -0.4 and abs(pelvis[2] - head[2]) < 0.1
     assert np.all(feet[:, 0] < pelvis[0] - 0.6) and np.all(np.abs(feet[:, 2] - head[2]) < 0.15)
+
+
+def test_output_does_not_amplify_rounding(dribble, dribble_output):
+    """Device positions moved by 1e-12 m (what BLAS rounding of another OpenBLAS kernel does
+    to the QP) move the output by far less than a micrometre. Before the IK's step damping
+    (``avatar_models.body.ik.IKSettings.damping``) the solve oscillated and grew such a
+    difference 3x per tick: 41 cm of body17 position within 20 ticks."""
+    motion, stream = dribble
+    rng = np.random.default_rng(0)
+    nudged = stream.replace(
+        positions=stream.positions + 1e-12 * rng.standard_normal(stream.positions.shape)
+    )
+    out = IKBaseline(motion.skeleton, standing_height(motion)).run(nudged)
+    # measured 8e-12 m (no step damping: 7e-7 m even on this calm clip)
+    assert np.abs(body17_positions(out) - body17_positions(dribble_output)).max() < 1e-8
