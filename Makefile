@@ -18,6 +18,8 @@ $(STAMP): pyproject.toml constraints.txt requirements.lock
 	$(BIN)/pip install -q torch==$(TORCH)
 	$(BIN)/pip install -q --no-deps -r requirements.lock
 	$(BIN)/pip install -q --no-deps -e .
+	# An existing venv already holds pyrender, whose PyOpenGL pin pip check would report.
+	$(BIN)/pip uninstall -q -y pyrender
 	$(BIN)/pip check
 	# pyrender pins PyOpenGL==3.1.0, which breaks mujoco's EGL: install it without deps
 	# (its other dependencies are in pyproject.toml, PyOpenGL>=3.1.7 among them).
