@@ -16,7 +16,7 @@ from avatar_models.generator import generate, sample_subject
 from avatar_models.motion import Motion
 from avatar_models.rigs import load_rig
 from sim.soles import foot_bodies
-from sim.tracking import Tracker, TrackingSettings, looped, track
+from sim.tracking import Tracker, TrackingResult, TrackingSettings, looped, track
 
 BANDAI_WALK = "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh"
 
@@ -164,13 +164,24 @@ def test_ankle_torques_are_what_statics_demands_leaning_forward(subject):
         rng = np.random.default_rng(5)
         people = [sample_subject(rng) for _ in range(2)]
         lean_body = build_body(generate("walk", people[subject], 0.1, 30.0).skeleton)
-    model = humanoid_model(lean_body)
-    result = track(model, lean_body.qpos_from_motion(_leaning(lean_body, 4.0)), 30.0)
+    result, moments = ankle_balance(lean_body, 4.0)
     assert not result.fell and result.body17_error[-1].mean() < 0.01
+    for t, (demanded, supplied) in moments.items():
+        assert abs(demanded) > 30.0  # the lean makes it a real load (N m)
+        assert abs(supplied - demanded) < 0.02 * abs(demanded) + 0.5, (t, supplied, demanded)
+
+
+def ankle_balance(body, degrees: float) -> tuple[TrackingResult, dict[int, tuple[float, float]]]:
+    """Track ``body`` held leaning ``degrees`` forward; the result and, at frames 40, 50 and
+    60, the (demanded, supplied) moment about the ankle line (N m): the weight of the body
+    without its feet about that line, and the ankle actuators' torques about it."""
+    model = humanoid_model(body)
+    result = track(model, body.qpos_from_motion(_leaning(body, degrees)), 30.0)
     data = mujoco.MjData(model)
     feet = [model.body(name).id for name in foot_bodies(model)]
     at_ankle = [k for k, j in enumerate(model.actuator_trnid[:, 0]) if model.jnt_bodyid[j] in feet]
     mass, foot_mass = model.body_subtreemass[0], model.body_subtreemass[feet]
+    moments = {}
     for t in (40, 50, 60):
         data.qpos[:] = result.qpos[t]
         mujoco.mj_kinematics(model, data)
@@ -183,9 +194,8 @@ def test_ankle_torques_are_what_statics_demands_leaning_forward(subject):
         u = (left - right) / np.linalg.norm(left - right)
         demanded = np.cross(com - left, [0.0, 0.0, -weight]) @ u
         axes = data.xaxis[model.actuator_trnid[at_ankle, 0]]
-        supplied = result.torque[t, at_ankle] @ (axes @ u)
-        assert abs(demanded) > 30.0  # the lean makes it a real load (N m)
-        assert abs(supplied - demanded) < 0.02 * abs(demanded) + 0.5, (t, supplied, demanded)
+        moments[t] = (float(demanded), float(result.torque[t, at_ankle] @ (axes @ u)))
+    return result, moments
 
 
 # Walks the plain controller was measured on: (subject index or None for the default, seed).
