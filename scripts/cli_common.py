@@ -155,9 +155,18 @@ def check_outputs(
     check_output_dir(out, "--out", out_owner)
     check_output_dir(export, "--export")
     if out is not None and out_owner is not None:
-        root = Path(out).absolute()
-        for option, path in [("--json", json_out), *(files or {}).items()]:
-            if path is not None and root in Path(path).absolute().parents:
+        root = Path(os.path.abspath(out))
+        if root in Path(os.path.abspath(Path.cwd())).parents or root == Path.cwd().absolute():
+            raise AvatarsimError(
+                f"--out {out} is the current folder or above it, and --out is replaced whole; "
+                "choose a folder of its own"
+            )
+        named = [("--json", json_out), ("--export", export), *(files or {}).items()]
+        for option, path in named:
+            if path is None:
+                continue
+            inside = Path(os.path.abspath(path))
+            if inside == root or root in inside.parents:
                 raise AvatarsimError(
                     f"{option} {path} is inside --out {out}, which is replaced whole; "
                     "write it elsewhere"

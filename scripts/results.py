@@ -162,6 +162,11 @@ def _check_owned(folder: Path, option: str, owner: str) -> None:
     present = _files_in(folder)
     if not present:
         return
+    if len(present) > _MAX_FILES:
+        raise AvatarsimError(
+            f"{option} {folder} holds more than {_MAX_FILES} files, more than any output of "
+            f"`avatarsim {owner}`; it would be replaced whole, so choose a new or empty folder"
+        )
     try:
         marker = json.loads((folder / OUTPUT_MARKER).read_text(encoding="utf-8"))
         command, files = str(marker["command"]), set(marker["files"])
@@ -190,7 +195,7 @@ def atomic_dir(final_dir: Path, owner: str) -> Iterator[Path]:
     output of ``owner`` (recorded in :data:`OUTPUT_MARKER` with the files written) holding
     nothing else; otherwise :class:`AvatarsimError`, before anything is written. A user's file
     is never deleted."""
-    final_dir = Path(final_dir)
+    final_dir = Path(os.path.abspath(final_dir))  # "." or "a/..": the parent is real
     check_output_dir(final_dir, "--out", owner)
     final_dir.parent.mkdir(parents=True, exist_ok=True)
     out_dir = Path(tempfile.mkdtemp(dir=final_dir.parent, prefix=f".{final_dir.name}.partial-"))

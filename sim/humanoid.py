@@ -103,14 +103,19 @@ def humanoid_for(
         MotionValueError: a rig with no body17 map, a height outside (0, 3] m.
         BodyError: a skeleton no body can be built from.
     """
+    subject = motion.meta.get("subject")
+    subject = subject if isinstance(subject, dict) else {}  # a library clip's is a label
     if mass_kg is None:
-        mass_kg = (motion.meta.get("subject") or {}).get("mass_kg", DEFAULT_MASS_KG)
+        mass_kg = subject.get("mass_kg", DEFAULT_MASS_KG)
     if height_m is not None:
         if not (np.isfinite(height_m) and 0.0 < height_m <= 3.0):
             raise MotionValueError(f"body height must be in (0, 3] m, got {height_m!r}")
         factor = height_m / standing_height(motion)
+        meta = dict(motion.meta)
+        if subject:  # the built-in subject's recorded height follows (synthesis reads it)
+            meta["subject"] = subject | {"height_m": float(height_m)}
         motion = motion.replace(
-            skeleton=motion.skeleton.scaled(factor), root_pos=motion.root_pos * factor
+            skeleton=motion.skeleton.scaled(factor), root_pos=motion.root_pos * factor, meta=meta
         )
     try:
         body = build_body(motion.skeleton, mass_kg=mass_kg)

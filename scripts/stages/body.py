@@ -6,6 +6,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from avatar_models.formats import save_motion
 from scripts.results import write_atomic
 from scripts.run_context import RunContext
 from sim.humanoid import humanoid_for
@@ -21,7 +22,10 @@ METRICS = {
 def run(ctx: RunContext) -> None:
     spec = ctx.scenario.body
     h = ctx.humanoid = humanoid_for(ctx.motion, height_m=spec.height_m, mass_kg=spec.mass_kg)
-    ctx.motion = h.source  # the ground truth at the body's height
+    if spec.height_m is not None:  # the ground truth at the body's height, saved as such
+        ctx.motion = h.source
+        ctx.output("motion_bvh", save_motion(ctx.motion, ctx.out_dir / "motion.bvh"))
+        ctx.info["motion"]["height_m"] = spec.height_m
     ctx.output("mjcf", write_atomic(ctx.out_dir / "humanoid.xml", h.mjcf))
 
     # Exactness of the pose -> qpos mapping: MuJoCo's bodies against the motion's FK.

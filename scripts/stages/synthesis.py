@@ -75,8 +75,10 @@ def run(ctx: RunContext) -> None:
     if spec is None:
         return
     stream = ctx.artifacts["vr_stream"]
-    subject = ctx.motion.meta.get("subject") or {}
-    user_height_m = subject.get("height_m") or standing_height(ctx.motion)
+    subject = ctx.motion.meta.get("subject")
+    user_height_m = (subject.get("height_m") if isinstance(subject, dict) else None) or (
+        standing_height(ctx.motion)
+    )
     outputs: dict[str, Humanoid] = {}
     for method in spec.methods:
         output = make_synthesizer(method, ctx, user_height_m).run(stream)

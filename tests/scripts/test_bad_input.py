@@ -456,3 +456,15 @@ def test_numpy_warnings_never_come_before_the_error_line(tmp_path, monkeypatch):
     result = runner.invoke(app, ["info", str(tmp_path / "a.bvh")])
     assert result.exit_code == 0
     assert result.stderr.count("warning: RuntimeWarning: divide by zero") == 1
+
+
+def test_out_that_is_the_working_folder_or_holds_the_export_exits_2(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    for args in (
+        ["track", "builtin:walk", "--plain", "--seconds", "0.5", "--out", "."],
+        ["track", "builtin:walk", "--plain", "--seconds", "0.5", "--out", "o", "--export", "o"],
+        ["track", "builtin:walk", "--plain", "--seconds", "0.5", "--out", "o", "--export", "o/v"],
+    ):
+        result = runner.invoke(app, args)
+        assert result.exit_code == 2, (args, result.output)
+    assert sorted(p.name for p in tmp_path.iterdir()) == []

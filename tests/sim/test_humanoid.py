@@ -77,3 +77,12 @@ def test_bandai_is_retargeted_once_and_levelled_on_the_same_model(mocap_dir):
     levelled = h.for_tracking()
     assert levelled.levelled and levelled.model is h.model and levelled.body is h.body
     assert levelled.for_tracking() is levelled
+
+
+def test_a_subject_label_is_not_a_subject_record():
+    """Library clips carry ``meta["subject"]`` as a label; only the generator's is a record."""
+    walk = generate("walk", duration_s=0.3)
+    labelled = walk.replace(meta={**walk.meta, "subject": "S01"})
+    assert humanoid_for(labelled).body.mass_kg == 75.0
+    scaled = humanoid_for(walk, height_m=1.9).source
+    assert scaled.meta["subject"]["height_m"] == 1.9
