@@ -138,9 +138,10 @@ def register(app: typer.Typer) -> None:
             )
         emit_json(json_out, summary)
         if not summary["completed"]:
+            upright_s = summary["duration_s"] if not result.fell else result.fall_time_s
             err_console.print(
                 f"[red]not tracked to the end:[/] {summary['failure']} after "
-                f"{summary['duration_s']:.2f} s of {summary['requested_s']:.2f} s",
+                f"{upright_s:.2f} s of {summary['requested_s']:.2f} s",
                 highlight=False,
             )
             raise typer.Exit(1)
