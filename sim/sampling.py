@@ -65,6 +65,11 @@ class SearchSettings:
             simulated on from its end (the larger of both costs counts); 0: not at all.
         retry_factor, max_backtracks: what is done when every sample falls
             (:func:`search_track`).
+        budget: seconds simulated (samples, look-aheads, retries) per second of reference at
+            most; past it the search gives up, incomplete. A walk that tracks takes about 100
+            (3 s built-in walk: 15 windows x 48 samples x 0.4 s); a clip the controller cannot
+            follow (Bandai run_normal_001: the plain controller falls at 0.4 s) backtracks
+            without end, over 10 minutes for 3 s, without one.
         seed: random generator seed (the search is deterministic for a seed).
     """
 
@@ -81,6 +86,7 @@ class SearchSettings:
     lookahead_s: float = 0.2
     retry_factor: int = 4
     max_backtracks: int = 20
+    budget: float = 400.0
     seed: int = 0
 
 
@@ -106,8 +112,9 @@ class SearchedTracking:
         window_steps: simulation steps per window.
         simulated_s: seconds simulated in all, samples included (the search's cost).
         completed: whether the path reaches the reference's end; ``False`` when the search
-            gave up (every sample fell, retries and backtracks exhausted) and ``result`` is
-            the path that fell last, shorter than the reference.
+            gave up: every sample fell, retries and backtracks exhausted (``result`` is the
+            path that fell last), or the budget was spent (``result`` is the best path so
+            far, upright); either is shorter than the reference.
     """
 
     result: TrackingResult
@@ -171,7 +178,9 @@ def search_track(
     :attr:`SearchSettings.retry_factor` times as many samples; when those fall too, the search
     steps back one window (two after a second failure in a row, and so on) and samples from
     there again (at most :attr:`SearchSettings.max_backtracks` times in all). If nothing
-    survives even then, the path that fell last is returned (its result says when it fell)."""
+    survives even then, the path that fell last is returned (its result says when it fell).
+    Past :attr:`SearchSettings.budget` the search stops with the best path so far, upright
+    but short of the reference's end."""
     search = search or SearchSettings()
     tracker = Tracker(model, settings)
     m, d = tracker.model, tracker.data
@@ -212,7 +221,12 @@ def search_track(
     simulated, backtracks, last_fallen = 0, 0, history[0][0]
     furthest, depth = 1, 1  # windows reached; how far the next step back goes
     bar = tqdm(total=tracker.steps_of(ref), unit="step", disable=not progress_bar, leave=False)
+    budget_steps = search.budget * tracker.steps_of(ref)
+    over_budget = False
     while not tracker.finished(ref, history[-1][0].progress):
+        if simulated > budget_steps:
+            over_budget = True
+            break
         samples, children = search.samples, []
         for _ in range(2):
             children = expand(history[-1], samples)
@@ -235,7 +249,7 @@ def search_track(
         bar.update(history[-1][0].progress.step - bar.n)
     bar.close()
     completed = tracker.finished(ref, history[-1][0].progress)
-    best = history[-1][0] if completed else last_fallen
+    best = history[-1][0] if completed or over_budget else last_fallen
     return SearchedTracking(
         result=tracker.result(ref, best.progress.frames),
         offsets=np.array(best.offsets).reshape(-1, m.nu),

@@ -71,3 +71,20 @@ def test_searched_bandai_walk_10_s_without_falling(mocap_dir):
     searched = search_track(model, qpos, walk.motion.fps)
     _summary_line("searched bandai walk", searched.result)
     assert not searched.result.fell
+
+
+def test_search_stops_at_its_budget_upright_and_incomplete(body):
+    """A search that cannot finish within its budget (simulated seconds per second of
+    reference) gives up with its best path so far, which has not fallen. With a budget of 5:
+    the first window costs 8 samples x 0.4 s (window + look-ahead) = 3.2 s, the second
+    6 x 8 x 0.4 = 19.2 s, which spends 1 s of reference's 5 s; the third never starts."""
+    walk = generate("walk", duration_s=1.0, fps=30.0, seed=0)
+    searched = search_track(
+        humanoid_model(body),
+        body.qpos_from_motion(walk),
+        walk.fps,
+        search=SearchSettings(budget=5.0),
+    )
+    assert not searched.completed and not searched.result.fell
+    assert searched.offsets.shape[0] == 2  # two windows of 0.2 s
+    assert searched.simulated_s == pytest.approx(3.2 + 19.2, abs=0.05)
