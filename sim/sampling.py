@@ -113,8 +113,8 @@ class SearchedTracking:
         simulated_s: seconds simulated in all, samples included (the search's cost).
         completed: whether the path reaches the reference's end; ``False`` when the search
             gave up: every sample fell, retries and backtracks exhausted (``result`` is the
-            path that fell last), or the budget was spent (``result`` is the best path so
-            far, upright); either is shorter than the reference.
+            path that fell last), or the budget was spent (``result`` is the best path that
+            got furthest, upright); either is shorter than the reference.
     """
 
     result: TrackingResult
@@ -179,8 +179,8 @@ def search_track(
     steps back one window (two after a second failure in a row, and so on) and samples from
     there again (at most :attr:`SearchSettings.max_backtracks` times in all). If nothing
     survives even then, the path that fell last is returned (its result says when it fell).
-    Past :attr:`SearchSettings.budget` the search stops with the best path so far, upright
-    but short of the reference's end."""
+    Past :attr:`SearchSettings.budget` the search stops with the best path that got
+    furthest, upright but short of the reference's end."""
     search = search or SearchSettings()
     tracker = Tracker(model, settings)
     m, d = tracker.model, tracker.data
@@ -222,7 +222,7 @@ def search_track(
     furthest, depth = 1, 1  # windows reached; how far the next step back goes
     bar = tqdm(total=tracker.steps_of(ref), unit="step", disable=not progress_bar, leave=False)
     budget_steps = search.budget * tracker.steps_of(ref)
-    over_budget = False
+    over_budget, deepest = False, history[0][0]  # deepest: the best state furthest along
     while not tracker.finished(ref, history[-1][0].progress):
         if simulated > budget_steps:
             over_budget = True
@@ -245,11 +245,11 @@ def search_track(
             continue
         history.append([c for c in children if np.isfinite(c.cost)][: search.beam])
         if len(history) > furthest:
-            furthest, depth = len(history), 1
+            furthest, depth, deepest = len(history), 1, history[-1][0]
         bar.update(history[-1][0].progress.step - bar.n)
     bar.close()
     completed = tracker.finished(ref, history[-1][0].progress)
-    best = history[-1][0] if completed or over_budget else last_fallen
+    best = history[-1][0] if completed else deepest if over_budget else last_fallen
     return SearchedTracking(
         result=tracker.result(ref, best.progress.frames),
         offsets=np.array(best.offsets).reshape(-1, m.nu),
