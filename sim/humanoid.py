@@ -28,6 +28,7 @@ from avatar_models.body import BodyDescription, BodyError, build_body
 from avatar_models.errors import MotionValueError
 from avatar_models.measure import standing_height
 from avatar_models.motion import Motion
+from avatar_models.rigs import identify_rig
 
 DEFAULT_MASS_KG = 75.0
 
@@ -72,7 +73,7 @@ class Humanoid:
     def summary(self) -> dict:
         """Provenance for results files: rig, retargeting and its residual."""
         out = {
-            "source_rig": self.source.skeleton.name,
+            "source_rig": identify_rig(self.source.skeleton).name,
             "body_rig": self.body.rig.name,
             "retargeted": self.retargeted,
             "mass_kg": self.body.mass_kg,

@@ -146,15 +146,11 @@ def check_motion(
     ``config`` (defaults: :class:`CheckConfig`).
 
     Raises:
-        MotionValueError: non-finite motion; a motion not on ``body``'s skeleton.
-        BodyError: see :func:`sim.humanoid.humanoid_for`.
+        MotionValueError: non-finite motion.
+        BodyError: a motion not on ``body``'s skeleton; see :func:`sim.humanoid.humanoid_for`.
     """
     if not (np.all(np.isfinite(motion.root_pos)) and np.all(np.isfinite(motion.local_rot))):
         raise MotionValueError("motion has NaN/inf values")
     if body is None:
         return check_humanoid(humanoid_for(motion), config, checks)
-    if not motion.skeleton.same_topology(body.skeleton):
-        raise MotionValueError(
-            f"motion rig {motion.skeleton.name!r} is not the body's rig {body.skeleton.name!r}"
-        )
     return check_qpos(body, body.qpos_from_motion(motion), motion.fps, config, checks)

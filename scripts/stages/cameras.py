@@ -34,8 +34,7 @@ def metrics_for(scenario: Scenario) -> set[str]:
 def window(ctx: RunContext):
     """A few frames mid-clip of the motion on the humanoid (the ground truth itself on an own
     rig, its retargeting on a foreign one), and the humanoid's body to render."""
-    motion = ctx.motion if ctx.humanoid is None else ctx.humanoid.motion
-    body = None if ctx.humanoid is None else ctx.humanoid.body
+    motion, body = ctx.humanoid.motion, ctx.humanoid.body
     middle = motion.n_frames // 2
     return motion[middle : middle + max(2, int(round(WINDOW_S * motion.fps)))], body
 
