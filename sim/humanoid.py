@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from avatar_models.body import BodyDescription, BodyError, build_body
+from avatar_models.body import BodyDescription, BodyError, build_body, control_spec
 from avatar_models.errors import MotionValueError
 from avatar_models.measure import standing_height
 from avatar_models.motion import Motion
@@ -44,9 +44,10 @@ class Humanoid:
         residual_cm: ``(T,)`` mean body17 site-to-target distance of the retargeting (zeros
             for an own rig).
         source: the motion as given (after any height scaling).
-        mjcf: the body's MJCF, generated once.
-        model: ``mjcf`` compiled once, shared by every stage: read it, do not edit it (the
-            tracker works on a copy of its own).
+        mjcf: the body's MJCF text (MuJoCo's export of ``body.spec``, for its viewer).
+        model: ``body.spec`` compiled once (:attr:`BodyDescription.model`), shared by every
+            stage: read it, do not edit it (physics control compiles its own variant,
+            :meth:`control_model`).
         levelled: whether stance feet were levelled for tracking.
     """
 
@@ -62,6 +63,16 @@ class Humanoid:
     @property
     def retargeted(self) -> bool:
         return self.motion is not self.source
+
+    @property
+    def spec(self) -> mujoco.MjSpec:
+        """The body's spec (``model``'s source); edit a ``spec.copy()``."""
+        return self.body.spec
+
+    def control_model(self) -> mujoco.MjModel:
+        """A new compiled physics-control variant of ``model``
+        (:func:`avatar_models.body.control_spec`): motors, only floor contacts."""
+        return control_spec(self.body.spec).compile()
 
     def for_tracking(self) -> Humanoid:
         """This humanoid with stance feet levelled for physics tracking (module docstring);
@@ -124,19 +135,13 @@ def humanoid_for(
         if "not upright" not in str(exc):
             raise
     else:
-        mjcf = body.to_mjcf()
         qpos = body.qpos_from_motion(motion)
         zero = np.zeros(motion.n_frames)
-        return Humanoid(body, motion, qpos, zero, motion, mjcf, _compile(mjcf))
+        return Humanoid(body, motion, qpos, zero, motion, body.to_mjcf(), body.model)
     from sim.retarget import humanoid_body  # IK (mink) is only loaded when needed
 
     body = humanoid_body(motion, mass_kg=mass_kg)
-    mjcf = body.to_mjcf()
-    return _retargeted(body, motion, mjcf, _compile(mjcf), level_feet)
-
-
-def _compile(mjcf: str) -> mujoco.MjModel:
-    return mujoco.MjModel.from_xml_string(mjcf)
+    return _retargeted(body, motion, body.to_mjcf(), body.model, level_feet)
 
 
 def _retargeted(

@@ -114,7 +114,7 @@ def check_qpos(
 ) -> PlausibilityReport:
     """Run ``checks`` on ``qpos (T, nq)`` of ``body`` (e.g. a physics tracking result)."""
     config = config or CheckConfig()
-    model = model or mujoco.MjModel.from_xml_string(body.to_mjcf())
+    model = model or body.model
     replay = BodyReplay.run(body, model, qpos, fps, config)
     meta = {"rig": body.rig.name, "frames": int(qpos.shape[0]), "fps": float(fps)}
     meta["body_mass_kg"] = body.mass_kg

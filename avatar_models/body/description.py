@@ -145,11 +145,25 @@ class BodyDescription:
         return mesh_template(self.segments)
 
     # -- outputs --------------------------------------------------------------------------
-    def to_mjcf(self) -> str:
-        """MJCF XML of this body standing on a floor (see :mod:`avatar_models.body.mjcf`)."""
-        from avatar_models.body.mjcf import body_mjcf
+    @cached_property
+    def spec(self):
+        """The body's :class:`mujoco.MjSpec` (see :mod:`avatar_models.body.mjcf`), built once
+        and shared: edit a ``spec.copy()`` (e.g. :func:`~avatar_models.body.control_spec`)."""
+        from avatar_models.body.mjcf import body_spec
 
-        return body_mjcf(self)
+        return body_spec(self)
+
+    @cached_property
+    def model(self):
+        """:attr:`spec` compiled once (a ``mujoco.MjModel``), shared by every user of the
+        body: read it; simulations that change it work on their own copy."""
+        return self.spec.compile()
+
+    def to_mjcf(self) -> str:
+        """MJCF XML of this body standing on a floor, for MuJoCo's viewer (MuJoCo writes 6
+        significant digits: :attr:`model` is compiled from the spec, not from this text)."""
+        self.model  # noqa: B018  (MuJoCo writes XML from a compiled spec)
+        return self.spec.to_xml()
 
     def qpos_from_motion(self, motion: Motion) -> np.ndarray:
         """``(T, nq)`` MuJoCo qpos for ``motion`` (see :mod:`avatar_models.body.qpos`)."""

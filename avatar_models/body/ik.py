@@ -100,8 +100,9 @@ class IKResult:
 
 
 def humanoid_model(body: BodyDescription) -> mujoco.MjModel:
-    """The compiled MuJoCo model of ``body``."""
-    return mujoco.MjModel.from_xml_string(body.to_mjcf())
+    """The compiled MuJoCo model of ``body`` (:attr:`BodyDescription.model`, compiled once
+    per body and shared: read it, do not edit it)."""
+    return body.model
 
 
 class HumanoidIK:

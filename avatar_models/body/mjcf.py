@@ -1,4 +1,7 @@
-"""MJCF of a :class:`~avatar_models.body.description.BodyDescription`, built with ElementTree.
+"""The MuJoCo model of a :class:`~avatar_models.body.description.BodyDescription`, built by
+composition with :class:`mujoco.MjSpec` (:func:`body_spec`) and compiled once per body
+(:attr:`BodyDescription.model`); :meth:`mujoco.MjSpec.to_xml` gives the MJCF text for
+MuJoCo's viewer.
 
 One MuJoCo body per simulated skeleton joint, named after the joint, at the joint's rest
 offset (rest local rotations are the identity, so no body ``quat``). The root body carries a
@@ -19,17 +22,19 @@ radian under gravity. ``m`` is what the joint carries when standing: the whole b
 joints (the toes too: the body rolls over them at push-off), the subtree below the joint
 otherwise. ``kv = kp * 0.05 s`` (a 50 ms time constant), integrated implicitly
 (``implicitfast``) so light distal segments stay stable.
+
+Every number enters the spec rounded to the decimal digits the model has always been written
+with (:func:`_decimal`: 9 significant digits, gains 6), so the compiled model is bit for bit
+the one the MJCF text of earlier versions compiled to, and results stay reproducible.
 """
 
 from __future__ import annotations
-
-import xml.etree.ElementTree as ET
 
 import mujoco
 import numpy as np
 
 from avatar_models.body.description import BodyDescription
-from avatar_models.body.geometry import combined_inertial
+from avatar_models.body.geometry import Segment, combined_inertial
 
 GRAVITY = 9.81
 STIFFNESS_MARGIN = 4.0
@@ -37,9 +42,15 @@ DAMPING_TIME_S = 0.05
 TIMESTEP_S = 0.002
 ARMATURE = 0.02
 PLACEHOLDER_MASS_KG = 1e-4
+PLACEHOLDER_INERTIA = 1e-8
 LEG_ROLES = ("pelvic_girdle", "hip", "knee", "ankle", "toe")
-AXIS_VECTORS = {"x": "1 0 0", "y": "0 1 0", "z": "0 0 1"}
-SEGMENT_RGBA = "0.8 0.6 0.45 1"
+AXIS_VECTORS = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+SEGMENT_RGBA = (0.8, 0.6, 0.45, 1.0)
+GEOM_SHAPES = {
+    "capsule": mujoco.mjtGeom.mjGEOM_CAPSULE,
+    "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
+    "box": mujoco.mjtGeom.mjGEOM_BOX,
+}
 
 
 def hinge_name(joint_name: str, axis: str) -> str:
@@ -53,191 +64,27 @@ def chain_name(joint_names, axis: str) -> str:
     return f"{'+'.join(joint_names)}:r{axis}"
 
 
-def body_mjcf(desc: BodyDescription) -> str:
-    """The MJCF XML string: floor, light, the body, actuators, contact exclusions."""
-    root = _model_without_exclusions(desc)
-    contact = ET.SubElement(root, "contact")
-    for a, b in _adjacent_bodies(desc, ET.tostring(root, encoding="unicode")):
-        ET.SubElement(contact, "exclude", body1=a, body2=b)
-    ET.indent(root)
-    return ET.tostring(root, encoding="unicode")
+def body_spec(desc: BodyDescription) -> mujoco.MjSpec:
+    """A new spec of ``desc``: floor, lights, the body, actuators, tendons, contact
+    exclusions. The caller owns it (edit a :meth:`~mujoco.MjSpec.copy` of a shared one)."""
+    spec = _spec_without_exclusions(desc)
+    for a, b in adjacent_bodies(desc, spec):
+        spec.add_exclude(bodyname1=a, bodyname2=b)
+    return spec
 
 
-def _fmt(values) -> str:
-    return " ".join(f"{float(v):.9g}" for v in np.ravel(values))
+def adjacent_bodies(desc: BodyDescription, spec: mujoco.MjSpec) -> list[tuple[str, str]]:
+    """Body pairs of ``spec`` that must not collide, sorted: parent and child (ankle and toes
+    included), and pairs whose geoms already touch in the rest pose (thighs at the crotch,
+    bodies joined by zero-length bones).
 
-
-def _model_without_exclusions(desc: BodyDescription) -> ET.Element:
-    sk = desc.skeleton
-    root = ET.Element("mujoco", model=f"avatarsim_{sk.name or 'body'}")
-    ET.SubElement(root, "compiler", angle="radian", autolimits="true")
-    ET.SubElement(root, "option", timestep=str(TIMESTEP_S), integrator="implicitfast")
-    default = ET.SubElement(root, "default")
-    ET.SubElement(default, "joint", type="hinge", armature=str(ARMATURE), limited="true")
-    ET.SubElement(default, "geom", condim="3", friction="1 0.005 0.0001", rgba=SEGMENT_RGBA)
-    ET.SubElement(default, "site", size="0.01", rgba="0.9 0.1 0.1 1", group="4")
-    asset = ET.SubElement(root, "asset")
-    ET.SubElement(
-        asset,
-        "texture",
-        name="grid",
-        type="2d",
-        builtin="checker",
-        width="512",
-        height="512",
-        rgb1="0.2 0.3 0.4",
-        rgb2="0.3 0.4 0.5",
-    )
-    ET.SubElement(asset, "material", name="grid", texture="grid", texrepeat="8 8")
-    ET.SubElement(
-        asset,
-        "texture",
-        name="sky",
-        type="skybox",
-        builtin="gradient",
-        width="256",
-        height="256",
-        rgb1="0.55 0.65 0.75",
-        rgb2="0.1 0.12 0.15",
-    )
-    # A 1024 shadow map (MuJoCo's default is 4096) is plenty for the report's few-hundred-pixel
-    # pictures and halves the software (llvmpipe) render time per frame.
-    ET.SubElement(ET.SubElement(root, "visual"), "quality", shadowsize="1024")
-    world = ET.SubElement(root, "worldbody")
-    ET.SubElement(
-        world,
-        "light",
-        name="sun",
-        pos="0 0 5",
-        dir="0 0 -1",
-        directional="true",
-        diffuse="0.4 0.4 0.4",
-        castshadow="false",
-    )
-    ET.SubElement(world, "geom", name="floor", type="plane", size="0 0 0.05", material="grid")
-
-    rest = sk.rest_positions()
-    bodies: dict[int, ET.Element] = {}
-    actuator = ET.Element("actuator")
-    for j in desc.simulated_joints:
-        j = int(j)
-        if j == 0:
-            body = ET.SubElement(
-                world, "body", name=sk.names[0], pos=_fmt([0, 0, desc.root_height])
-            )
-            ET.SubElement(body, "freejoint", name="root")
-            # A light that follows the body, so renders keep a lit subject and its shadow
-            # wherever it walks (the directional "sun" alone leaves it dark far from the origin).
-            ET.SubElement(
-                body,
-                "light",
-                name="follow",
-                mode="trackcom",
-                pos="1.5 -1.5 3",
-                dir="-0.4 0.4 -1",
-                diffuse="0.6 0.6 0.6",
-                castshadow="true",
-            )
-        else:
-            body = ET.SubElement(
-                bodies[int(sk.parents[j])], "body", name=sk.names[j], pos=_fmt(sk.offsets[j])
-            )
-            _add_hinges(desc, j, body, actuator)
-        bodies[j] = body
-        _add_inertial_and_geoms(desc, j, body)
-    for name, j in desc.anatomy.body17.items():
-        carrier = int(desc.anatomy.body_of[j])
-        ET.SubElement(bodies[carrier], "site", name=name, pos=_fmt(rest[j] - rest[carrier]))
-    if desc.chains:
-        tendon = ET.SubElement(root, "tendon")
-        for chain in desc.chains:
-            names = [sk.names[j] for j in chain]
-            for axis, (lo, hi) in desc.hinge_ranges[chain[0]].items():
-                fixed = ET.SubElement(
-                    tendon, "fixed", name=chain_name(names, axis), range=_fmt([lo, hi])
-                )
-                for name in names:
-                    ET.SubElement(fixed, "joint", joint=hinge_name(name, axis), coef="1")
-    root.append(actuator)
-    return root
-
-
-def _add_hinges(desc: BodyDescription, j: int, body: ET.Element, actuator: ET.Element) -> None:
-    role = desc.anatomy.roles[j]
-    load = desc.mass_kg if role in LEG_ROLES else desc.subtree_mass[j]
-    kp = STIFFNESS_MARGIN * GRAVITY * load * 0.5 * desc.stature
-    for axis in desc.hinge_order(j).lower():
-        name = hinge_name(desc.skeleton.names[j], axis)
-        lo, hi = desc.hinge_ranges[j][axis]
-        ET.SubElement(body, "joint", name=name, axis=AXIS_VECTORS[axis], range=_fmt([lo, hi]))
-        ET.SubElement(
-            actuator,
-            "position",
-            name=name,
-            joint=name,
-            kp=f"{kp:.6g}",
-            kv=f"{kp * DAMPING_TIME_S:.6g}",
-            ctrlrange=_fmt([lo, hi]),
-        )
-
-
-def _add_inertial_and_geoms(desc: BodyDescription, j: int, body: ET.Element) -> None:
-    segments = [s for s in desc.segments if s.body == j]
-    if not segments:
-        # A body at the end of a zero-length bone: MuJoCo needs some mass on every moving
-        # body; its hinges still move the inertia of everything below.
-        ET.SubElement(
-            body,
-            "inertial",
-            pos="0 0 0",
-            mass=str(PLACEHOLDER_MASS_KG),
-            diaginertia="1e-8 1e-8 1e-8",
-        )
-        return
-    mass, com, inertia = combined_inertial(segments)
-    full = [
-        inertia[0, 0],
-        inertia[1, 1],
-        inertia[2, 2],
-        inertia[0, 1],
-        inertia[0, 2],
-        inertia[1, 2],
-    ]
-    ET.SubElement(body, "inertial", pos=_fmt(com), mass=f"{mass:.9g}", fullinertia=_fmt(full))
-    for s in segments:
-        if s.shape == "capsule":
-            ET.SubElement(
-                body,
-                "geom",
-                name=s.name,
-                type="capsule",
-                fromto=_fmt([s.start, s.end]),
-                size=f"{s.radius:.9g}",
-            )
-        elif s.shape == "sphere":
-            ET.SubElement(
-                body, "geom", name=s.name, type="sphere", pos=_fmt(s.start), size=f"{s.radius:.9g}"
-            )
-        else:
-            quat = [np.cos(s.heading / 2), 0.0, 0.0, np.sin(s.heading / 2)]
-            ET.SubElement(
-                body,
-                "geom",
-                name=s.name,
-                type="box",
-                pos=_fmt(s.start),
-                quat=_fmt(quat),
-                size=_fmt(s.half_extents),
-            )
-
-
-def _adjacent_bodies(desc: BodyDescription, xml: str) -> list[tuple[str, str]]:
-    """Body pairs that must not collide: parent and child (ankle and toes included), and pairs
-    whose geoms already touch in the rest pose (thighs at the crotch, bodies joined by
-    zero-length bones)."""
+    The touching pairs come from MuJoCo's own collision detection at the rest pose, which
+    runs only on a compiled model: MuJoCo forces this one compile of a copy of ``spec`` (an
+    own narrow phase for capsules, spheres and boxes would have to agree with MuJoCo's on
+    every contact at zero distance)."""
     sk = desc.skeleton
     pairs = {(sk.names[int(sk.parents[j])], sk.names[int(j)]) for j in desc.simulated_joints[1:]}
-    model = mujoco.MjModel.from_xml_string(xml)
+    model = spec.copy().compile()
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     for c in data.contact[: data.ncon]:
@@ -245,3 +92,157 @@ def _adjacent_bodies(desc: BodyDescription, xml: str) -> list[tuple[str, str]]:
         if b1 and b2:
             pairs.add((model.body(b1).name, model.body(b2).name))
     return sorted(pairs)
+
+
+def _decimal(values, digits: int = 9) -> list[float]:
+    """``values`` flattened, each rounded to ``digits`` significant decimal digits (the
+    module docstring says why)."""
+    return [float(f"{float(v):.{digits}g}") for v in np.ravel(values)]
+
+
+def _spec_without_exclusions(desc: BodyDescription) -> mujoco.MjSpec:
+    sk = desc.skeleton
+    spec = mujoco.MjSpec()
+    spec.modelname = f"avatarsim_{sk.name or 'body'}"
+    spec.compiler.degree = False
+    spec.compiler.autolimits = True
+    spec.option.timestep = TIMESTEP_S
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    _set_defaults(spec)
+    _add_scenery(spec)
+
+    rest = sk.rest_positions()
+    bodies: dict[int, mujoco.MjsBody] = {}
+    for j in desc.simulated_joints:
+        j = int(j)
+        if j == 0:
+            body = spec.worldbody.add_body(name=sk.names[0], pos=_decimal([0, 0, desc.root_height]))
+            body.add_freejoint(name="root")
+            # A light that follows the body, so renders keep a lit subject and its shadow
+            # wherever it walks (the directional "sun" alone leaves it dark far from the origin).
+            body.add_light(
+                name="follow",
+                mode=mujoco.mjtCamLight.mjCAMLIGHT_TRACKCOM,
+                pos=[1.5, -1.5, 3.0],
+                dir=[-0.4, 0.4, -1.0],
+                diffuse=[0.6, 0.6, 0.6],
+                castshadow=True,
+            )
+        else:
+            body = bodies[int(sk.parents[j])].add_body(
+                name=sk.names[j], pos=_decimal(sk.offsets[j])
+            )
+            _add_hinges(spec, desc, j, body)
+        bodies[j] = body
+        _add_inertial_and_geoms(desc, j, body)
+    for name, j in desc.anatomy.body17.items():
+        carrier = int(desc.anatomy.body_of[j])
+        bodies[carrier].add_site(name=name, pos=_decimal(rest[j] - rest[carrier]))
+    for chain in desc.chains:
+        names = [sk.names[j] for j in chain]
+        for axis, (lo, hi) in desc.hinge_ranges[chain[0]].items():
+            tendon = spec.add_tendon(name=chain_name(names, axis), range=_decimal([lo, hi]))
+            for name in names:
+                tendon.wrap_joint(hinge_name(name, axis), 1.0)
+    return spec
+
+
+def _set_defaults(spec: mujoco.MjSpec) -> None:
+    """Hinges with armature and limits; segment contact and colour; hidden body17 sites."""
+    joint, geom, site = spec.default.joint, spec.default.geom, spec.default.site
+    joint.type = mujoco.mjtJoint.mjJNT_HINGE
+    joint.armature = ARMATURE
+    joint.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+    geom.condim = 3
+    geom.friction = [1.0, 0.005, 0.0001]
+    geom.rgba = SEGMENT_RGBA
+    site.size = [0.01, site.size[1], site.size[2]]
+    site.rgba = [0.9, 0.1, 0.1, 1.0]
+    site.group = 4
+
+
+def _add_scenery(spec: mujoco.MjSpec) -> None:
+    """The checkered floor, the sky and the sun."""
+    spec.add_texture(
+        name="grid",
+        type=mujoco.mjtTexture.mjTEXTURE_2D,
+        builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
+        width=512,
+        height=512,
+        rgb1=[0.2, 0.3, 0.4],
+        rgb2=[0.3, 0.4, 0.5],
+    )
+    material = spec.add_material(name="grid", texrepeat=[8.0, 8.0])
+    material.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = "grid"
+    spec.add_texture(
+        name="sky",
+        type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
+        builtin=mujoco.mjtBuiltin.mjBUILTIN_GRADIENT,
+        width=256,
+        height=256,
+        rgb1=[0.55, 0.65, 0.75],
+        rgb2=[0.1, 0.12, 0.15],
+    )
+    # A 1024 shadow map (MuJoCo's default is 4096) is plenty for the report's few-hundred-pixel
+    # pictures and halves the software (llvmpipe) render time per frame.
+    spec.visual.quality.shadowsize = 1024
+    spec.worldbody.add_light(
+        name="sun",
+        pos=[0.0, 0.0, 5.0],
+        dir=[0.0, 0.0, -1.0],
+        type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
+        diffuse=[0.4, 0.4, 0.4],
+        castshadow=False,
+    )
+    spec.worldbody.add_geom(
+        name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[0.0, 0.0, 0.05], material="grid"
+    )
+
+
+def _add_hinges(spec: mujoco.MjSpec, desc: BodyDescription, j: int, body: mujoco.MjsBody):
+    role = desc.anatomy.roles[j]
+    load = desc.mass_kg if role in LEG_ROLES else desc.subtree_mass[j]
+    kp = STIFFNESS_MARGIN * GRAVITY * load * 0.5 * desc.stature
+    (kp_6,), (kv_6,) = _decimal([kp], 6), _decimal([kp * DAMPING_TIME_S], 6)
+    for axis in desc.hinge_order(j).lower():
+        name = hinge_name(desc.skeleton.names[j], axis)
+        limits = _decimal(desc.hinge_ranges[j][axis])
+        body.add_joint(name=name, axis=AXIS_VECTORS[axis], range=limits)
+        actuator = spec.add_actuator(
+            name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT, ctrlrange=limits
+        )
+        actuator.set_to_position(kp=kp_6, kv=kv_6)
+
+
+def _add_inertial_and_geoms(desc: BodyDescription, j: int, body: mujoco.MjsBody) -> None:
+    segments = [s for s in desc.segments if s.body == j]
+    body.explicitinertial = True
+    if not segments:
+        # A body at the end of a zero-length bone: MuJoCo needs some mass on every moving
+        # body; its hinges still move the inertia of everything below.
+        body.ipos = [0.0, 0.0, 0.0]
+        body.mass = PLACEHOLDER_MASS_KG
+        body.inertia = [PLACEHOLDER_INERTIA] * 3
+        return
+    mass, com, inertia = combined_inertial(segments)
+    body.ipos = _decimal(com)
+    body.mass = _decimal([mass])[0]
+    body.fullinertia = _decimal(inertia[[0, 1, 2, 0, 0, 1], [0, 1, 2, 1, 2, 2]])
+    for s in segments:
+        _add_geom(body, s)
+
+
+def _add_geom(body: mujoco.MjsBody, s: Segment) -> None:
+    """The primitive of segment ``s`` on ``body``: a capsule from start to end, a sphere at
+    start, a box at start turned by its heading about Z."""
+    geom = body.add_geom(name=s.name, type=GEOM_SHAPES[s.shape])
+    if s.shape == "capsule":
+        geom.fromto = _decimal([s.start, s.end])
+        geom.size = [_decimal([s.radius])[0], 0.0, 0.0]
+    elif s.shape == "sphere":
+        geom.pos = _decimal(s.start)
+        geom.size = [_decimal([s.radius])[0], 0.0, 0.0]
+    else:
+        geom.pos = _decimal(s.start)
+        geom.quat = _decimal([np.cos(s.heading / 2), 0.0, 0.0, np.sin(s.heading / 2)])
+        geom.size = _decimal(s.half_extents)

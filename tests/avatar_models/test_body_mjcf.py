@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import mujoco
 import numpy as np
 import pytest
@@ -14,11 +16,11 @@ from avatar_models.motion import Motion
 from avatar_models.rigs import load_rig
 
 RIGS = ("body17", "avatar", "cmu")
+DATA = Path(__file__).resolve().parents[1] / "data" / "mjcf"
 
 
 def _model(body: BodyDescription) -> tuple[mujoco.MjModel, mujoco.MjData]:
-    model = mujoco.MjModel.from_xml_string(body.to_mjcf())
-    return model, mujoco.MjData(model)
+    return body.model, mujoco.MjData(body.model)
 
 
 def _random_motion(rig: str, frames: int, seed: int, max_angle: float) -> Motion:
@@ -278,3 +280,45 @@ def test_chain_tendons_limit_the_sum_of_the_chains_hinges():
     mujoco.mj_tendon(model, data)
     assert data.ten_length[tendon.id] == pytest.approx(0.55)
     assert model.ntendon == 3 * len(body.chains) == 6  # spine and neck, x y z each
+
+
+def _array_fields(model: mujoco.MjModel) -> dict[str, np.ndarray]:
+    """Every numeric array of ``model`` and of its ``opt``, by name."""
+    out = {f"opt.{n}": getattr(model.opt, n) for n in dir(model.opt) if not n.startswith("_")}
+    out |= {n: getattr(model, n) for n in dir(model) if not n.startswith("_")}
+    return {n: np.asarray(v) for n, v in out.items() if isinstance(v, np.ndarray | int | float)}
+
+
+def test_model_is_the_mjcf_elementtree_wrote_before_mjspec():
+    """The avatar rig's model is bit for bit the one the MJCF text of commit 4b8d946
+    (ElementTree, 9 significant digits; tests/data/mjcf) compiles to."""
+    before = mujoco.MjModel.from_xml_path(str(DATA / "avatar_elementtree.xml"))
+    now = build_body(load_rig("avatar").skeleton).model
+    old, new = _array_fields(before), _array_fields(now)
+    assert old.keys() == new.keys() and len(new) > 300
+    differing = [n for n in new if not np.array_equal(old[n], new[n], equal_nan=True)]
+    assert differing == []
+
+
+@pytest.mark.parametrize("rig", ("avatar", "cmu"))
+def test_spec_model_matches_its_xml_round_trip(rig):
+    """MuJoCo's XML export of the spec recompiles to the same model: every integer array
+    equal, every float to the 6 significant digits MuJoCo writes."""
+    body = build_body(load_rig(rig).skeleton)
+    spec_model = body.model
+    xml_model = mujoco.MjModel.from_xml_string(body.to_mjcf())
+    ours, theirs = _array_fields(spec_model), _array_fields(xml_model)
+    assert ours.keys() == theirs.keys()
+    for name, value in ours.items():
+        if value.dtype.kind == "f":
+            np.testing.assert_allclose(theirs[name], value, rtol=1e-5, atol=1e-6, err_msg=name)
+        else:
+            np.testing.assert_array_equal(theirs[name], value, err_msg=name)
+
+
+def test_body_is_compiled_once_and_specs_are_shared_by_copy():
+    body = build_body(load_rig("avatar").skeleton)
+    assert body.model is body.model and body.spec is body.spec
+    edited = body.spec.copy()
+    edited.option.timestep = 0.01
+    assert edited.compile().opt.timestep == 0.01 and body.spec.option.timestep == 0.002

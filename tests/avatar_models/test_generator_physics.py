@@ -40,7 +40,7 @@ def test_generated_activity_is_physically_plausible(activity, i):
 def _mujoco_centre_of_mass(motion) -> np.ndarray:
     """``(T, 3)`` whole-body centre of mass, from MuJoCo's model of the body."""
     body = build_body(motion.skeleton)
-    model = mujoco.MjModel.from_xml_string(body.to_mjcf())
+    model = body.model
     data = mujoco.MjData(model)
     com = []
     for qpos in body.qpos_from_motion(motion):

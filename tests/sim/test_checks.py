@@ -99,7 +99,7 @@ def pivot_on_left_sole(body, yaw_deg: float, slide_m: float = 0.0, frames: int =
     local = m.local_rot.copy()
     local[:, knee] = quat.from_scipy(Rotation.from_euler(order, angles))
     m = m.replace(local_rot=local)
-    model = mujoco.MjModel.from_xml_string(body.to_mjcf())
+    model = body.model
     replay = BodyReplay.run(body, model, body.qpos_from_motion(m[:1]), m.fps, CheckConfig())
     heel, ball = replay.sole_points[0, 0, 0], replay.sole_points[0, 0, 1]
     centre = np.array([*(0.5 * (heel + ball))[:2], 0.0])
@@ -179,7 +179,7 @@ def _joint_limits(body, bends_deg: dict[str, tuple[float, str]]):
             Rotation.from_euler(axis, deg, degrees=True)
         )
     m = m.replace(local_rot=rot)
-    model = mujoco.MjModel.from_xml_string(body.to_mjcf())
+    model = body.model
     replay = BodyReplay.run(body, model, body.qpos_from_motion(m), m.fps, CheckConfig())
     return JointLimits()(replay, CheckConfig())
 
@@ -242,7 +242,7 @@ def test_self_collision_flags_forearms_through_each_other_not_the_rest_pose(rest
     assert l_hand[1] < 0.0 < r_hand[1]  # each hand is past the midline, on the other side
     assert l_hand[0] > 0.2 and abs(l_hand[2] - r_hand[2]) < 1e-9  # in front, one height
     report = check_motion(crossed, rest_body)
-    model = mujoco.MjModel.from_xml_string(rest_body.to_mjcf())
+    model = rest_body.model
     forearm = model.body("Bip01 L Forearm").id
     (geom,) = np.flatnonzero(model.geom_bodyid == forearm)
     assert model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_CAPSULE
