@@ -50,6 +50,7 @@ from avatar_models.body.anatomy import classify
 from avatar_models.body.ik import HumanoidIK, IKSettings, humanoid_model, motion_from_qpos
 from avatar_models.body17 import BODY17, INDEX
 from avatar_models.errors import MotionValueError, RigError
+from avatar_models.foot_contact import contact_mask, horizontal_speed
 from avatar_models.measure import standing_height
 from avatar_models.motion import Motion
 from avatar_models.rigs import body17_positions, load_rig
@@ -223,9 +224,13 @@ def stance_feet(positions: np.ndarray, fps: float) -> np.ndarray:
     (:data:`STANCE_HEIGHT_M`, :data:`STANCE_SPEED_M_S`)."""
     ankle = positions[:, [INDEX[a] for a, _ in FOOT_SITES]]
     toe_z = positions[:, [INDEX[t] for _, t in FOOT_SITES], 2]
-    speed = np.linalg.norm(np.gradient(ankle[..., :2], 1.0 / fps, axis=0), axis=-1)
-    low = toe_z < toe_z.min(axis=0) + STANCE_HEIGHT_M
-    return low & (speed < STANCE_SPEED_M_S)
+    return contact_mask(
+        toe_z,
+        STANCE_HEIGHT_M,
+        floor=toe_z.min(axis=0),
+        horizontal_speed=horizontal_speed(ankle, fps),
+        max_horizontal_speed=STANCE_SPEED_M_S,
+    )
 
 
 def match_foot_pitch(model, positions: np.ndarray, stance: np.ndarray) -> np.ndarray:
@@ -310,8 +315,8 @@ where the heel rises with the ball still on the floor, is slower."""
 def swinging_feet(positions: np.ndarray, fps: float) -> np.ndarray:
     """``(T, 2)`` whether the ball of the left and right foot moves faster than
     :data:`SWING_SPEED_M_S` horizontally in body17 ``positions (T, 17, 3)``."""
-    ball = positions[:, [INDEX[t] for _, t in FOOT_SITES], :2]
-    return np.linalg.norm(np.gradient(ball, 1.0 / fps, axis=0), axis=-1) > SWING_SPEED_M_S
+    ball = positions[:, [INDEX[t] for _, t in FOOT_SITES]]
+    return horizontal_speed(ball, fps) > SWING_SPEED_M_S
 
 
 def clear_swing_feet(

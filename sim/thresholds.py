@@ -5,7 +5,8 @@ Conventions follow the physics-based character literature: UHC (Luo et al. 2021,
 (Yuan et al. 2023, *PhysDiff: Physics-Guided Human Motion Diffusion Model*, ICCV). Heights and
 skating are measured in the floor frame (floor at z = 0, Z up):
 
-- **contact**: a foot point (the heel or the toe of a foot sole) touches the floor when its
+- **contact** (labelled by :mod:`avatar_models.foot_contact`, the labeller every module
+  shares): a foot point (the heel or the toe of a foot sole) touches the floor when its
   height is below ``contact_height_m`` AND its vertical speed is below ``contact_vz_m_s``
   (height and velocity, as UHC/PhysDiff label contacts; the vertical speed only, so that a
   foot sliding on the floor still counts as in contact and its sliding is measured). The

@@ -14,9 +14,9 @@ from functools import cached_property
 
 import mujoco
 import numpy as np
-from scipy import ndimage
 
 from avatar_models.body import BodyDescription, Segment
+from avatar_models.foot_contact import contact_mask, lasting
 from sim.replay import ReplayTrace, replay_kinematic
 from sim.thresholds import CheckConfig
 
@@ -130,17 +130,19 @@ class BodyReplay:
         ``contact_min_s`` in a row (a swinging toe skimming the floor for a frame or two, as
         it does in normal gait with ~1-2 cm clearance, is no stance)."""
         c = self.config
-        low = self.sole_points[..., 2] < c.contact_height_m
-        still = np.abs(self.sole_velocity[..., 2]) < c.contact_vz_m_s
-        slow = np.linalg.norm(self.sole_velocity[..., :2], axis=-1) < c.contact_vxy_m_s
-        points = low & still & slow
+        velocity = self.sole_velocity
+        points = contact_mask(
+            self.sole_points[..., 2],
+            c.contact_height_m,
+            vertical_velocity=velocity[..., 2],
+            max_vertical_speed=c.contact_vz_m_s,
+            horizontal_speed=np.linalg.norm(velocity[..., :2], axis=-1),
+            max_horizontal_speed=c.contact_vxy_m_s,
+        )
         run = max(1, int(np.ceil(c.contact_min_s * self.fps - 1e-9)))
-        if run == 1:
-            return points
-        # A foot's contact (any of its points) must last ``run`` frames: binary opening along
-        # time removes shorter runs and keeps the rest; its points keep their own labels.
-        foot = ndimage.binary_opening(points.any(axis=2), structure=np.ones((run, 1), dtype=bool))
-        return points & foot[..., None]
+        # A foot's contact (any of its points) must last ``run`` frames; its points keep
+        # their own labels.
+        return points & lasting(points.any(axis=2), run)[..., None]
 
     @property
     def foot_contact(self) -> np.ndarray:

@@ -1,10 +1,11 @@
 """Foot-contact clean-up of synthesised poses (beyond the paper, which admits foot sliding, §6).
 
 Contact labels follow the physics-based character literature (UHC, Luo et al. 2021; PhysDiff,
-Yuan et al. 2023, and ``sim.thresholds``): a foot is in contact when its ankle is less than
-``CONTACT_HEIGHT_M`` above the height it has standing on the floor AND its vertical speed is
-below ``CONTACT_VZ_M_S`` (the vertical speed only, so that a sliding foot still counts as in
-contact: that is the skating to remove).
+Yuan et al. 2023, and ``sim.thresholds``), by :func:`avatar_models.foot_contact.contact_mask`
+(the ankles' backward-difference vertical speed, causal for ``step()``): a foot is in
+contact when its ankle is less than ``CONTACT_HEIGHT_M`` above the height it has standing on
+the floor AND its vertical speed is below ``CONTACT_VZ_M_S`` (the vertical speed only, so
+that a sliding foot still counts as in contact: that is the skating to remove).
 
 Clean-up, causal so that it runs in ``step()``: at the first frame of a stance the ankle's
 horizontal position becomes the anchor; while the stance lasts, the ankle's target is the
@@ -20,6 +21,8 @@ arrays.
 from __future__ import annotations
 
 import numpy as np
+
+from avatar_models.foot_contact import contact_mask
 
 CONTACT_HEIGHT_M = 0.05
 """Foot-contact height of UHC and PhysDiff (5 cm), above the ankle's standing height."""
@@ -50,7 +53,13 @@ def contacts(ankles: np.ndarray, standing_z: np.ndarray, rate_hz: float) -> np.n
     """``(T, 2)`` contact labels of ankle positions ``(T, 2, 3)`` (world) given the ankles'
     standing heights ``(T|1, 2|1)``; the first frame's vertical speed counts as 0."""
     vz = np.diff(ankles[..., 2], axis=0, prepend=ankles[:1, :, 2]) * rate_hz
-    return (ankles[..., 2] - standing_z < CONTACT_HEIGHT_M) & (np.abs(vz) < CONTACT_VZ_M_S)
+    return contact_mask(
+        ankles[..., 2],
+        CONTACT_HEIGHT_M,
+        floor=standing_z,
+        vertical_velocity=vz,
+        max_vertical_speed=CONTACT_VZ_M_S,
+    )
 
 
 class FootContact:
