@@ -1,19 +1,24 @@
-"""Atomic file writes with ordinary permissions.
+"""Atomic file writes with ordinary permissions, and the one JSON writer.
 
 Every writer of avatarsim writes to a temporary file beside the target and renames it into
-place, so a reader never sees half a file. ``tempfile.mkstemp`` creates that file with mode
+place (:func:`atomic_file`, :func:`write_atomic`, :func:`write_json`), so a reader never sees
+half a file. ``tempfile.mkstemp`` creates that file with mode
 0600; :func:`atomic_file` gives it the mode a plain ``open()`` would have (0666 less the
 user's umask, 0644 with the usual umask 022) before the rename.
 """
 
 from __future__ import annotations
 
+import json
+import math
 import os
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Any
+
+import numpy as np
 
 
 def _umask() -> int:
@@ -47,3 +52,35 @@ def atomic_file(path: str | Path, mode: str = "wb", **open_kwargs: Any) -> Itera
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def write_atomic(path: str | Path, data: bytes | str) -> Path:
+    """Write ``data`` (text as UTF-8) to ``path`` atomically (:func:`atomic_file`)."""
+    with atomic_file(path) as fh:
+        fh.write(data.encode("utf-8") if isinstance(data, str) else data)
+    return Path(path)
+
+
+def json_safe(value: Any) -> Any:
+    """``value`` as plain JSON data: numpy scalars and arrays as Python values, tuples as
+    lists, NaN and infinities as ``None`` (strict JSON has no NaN), keys as strings."""
+    if isinstance(value, dict):
+        return {str(k): json_safe(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [json_safe(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return json_safe(value.tolist())
+    if isinstance(value, np.bool_ | bool):
+        return bool(value)
+    if isinstance(value, np.integer):
+        return int(value)
+    if isinstance(value, np.floating | float):
+        return float(value) if math.isfinite(value) else None
+    return value
+
+
+def write_json(path: str | Path, data: Any) -> Path:
+    """Write ``data`` to ``path`` atomically as strict JSON (:func:`json_safe`; other objects
+    as their ``str``), indented by 2, ending in a newline."""
+    text = json.dumps(json_safe(data), indent=2, allow_nan=False, default=str)
+    return write_atomic(path, text + "\n")

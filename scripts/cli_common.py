@@ -175,7 +175,7 @@ def check_outputs(
 
 def emit_json(path: Path | None, payload: dict[str, Any]) -> None:
     if path is not None:
-        from scripts.results import write_json
+        from avatar_models.fileio import write_json
 
         write_json(path, payload)
 

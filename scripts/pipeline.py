@@ -14,15 +14,9 @@ from typing import Any
 from rich.console import Console
 from rich.markup import escape
 
+from avatar_models.fileio import write_atomic, write_json
 from scripts.report_html import render_report
-from scripts.results import (
-    CheckResult,
-    atomic_dir,
-    junit_xml,
-    versions,
-    write_atomic,
-    write_json,
-)
+from scripts.results import ThresholdResult, atomic_dir, junit_xml, versions
 from scripts.run_context import RunContext
 from scripts.scenario import Scenario, ScenarioError
 from scripts.stages import STAGES, physics
@@ -81,7 +75,7 @@ def _run_stages(scenario: Scenario, out_dir: Path, console: Console) -> dict[str
         timings[name] = round(time.perf_counter() - t0, 3)
         console.log(f"{name} done in {timings[name]:.2f} s")
     checks = [
-        CheckResult(k, ctx.metrics[k], t) for k, t in scenario.thresholds.items()
+        ThresholdResult(k, ctx.metrics[k], t) for k, t in scenario.thresholds.items()
     ] + ctx.checks
     passed = all(c.passed for c in checks)
     results = {

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import json
-import math
 import os
 import platform
 import shutil
@@ -16,15 +15,17 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from avatar_models.errors import AvatarsimError
-from avatar_models.fileio import atomic_file, dir_mode
+from avatar_models.fileio import dir_mode, write_json
 from scripts.scenario import Threshold
 
 
 @dataclass(frozen=True)
-class CheckResult:
+class ThresholdResult:
+    """One scenario threshold applied to one run metric (a row of ``checks`` in
+    ``results.json`` and a JUnit testcase); not a physics check's finding
+    (:class:`sim.checks.CheckResult`)."""
+
     name: str
     value: float
     threshold: Threshold
@@ -222,36 +223,7 @@ def atomic_dir(final_dir: Path, owner: str) -> Iterator[Path]:
         raise
 
 
-def write_atomic(path: Path, data: bytes | str) -> Path:
-    """Write to a temp file in the same folder, then rename: readers never see half a file."""
-    with atomic_file(path) as fh:
-        fh.write(data.encode("utf-8") if isinstance(data, str) else data)
-    return path
-
-
-def _plain(value: Any) -> Any:
-    """JSON-safe: numpy scalars and arrays as Python values, NaN/inf as null (strict JSON)."""
-    if isinstance(value, dict):
-        return {str(k): _plain(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_plain(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return _plain(value.tolist())
-    if isinstance(value, np.bool_ | bool):
-        return bool(value)
-    if isinstance(value, np.integer):
-        return int(value)
-    if isinstance(value, np.floating | float):
-        return float(value) if math.isfinite(value) else None
-    return value
-
-
-def write_json(path: Path, payload: dict[str, Any]) -> Path:
-    text = json.dumps(_plain(payload), indent=2, allow_nan=False, default=str)
-    return write_atomic(path, text + "\n")
-
-
-def junit_xml(suite: str, checks: list[CheckResult], time_s: float = 0.0) -> str:
+def junit_xml(suite: str, checks: list[ThresholdResult], time_s: float = 0.0) -> str:
     """One testcase per check; a failed check carries a <failure> with value and threshold."""
     failures = sum(not c.passed for c in checks)
     root = ET.Element(

@@ -9,7 +9,7 @@ from typing import Any
 from rich.console import Console
 
 from avatar_models.motion import Motion
-from scripts.results import CheckResult
+from scripts.results import ThresholdResult
 from scripts.scenario import Scenario
 from sim.humanoid import Humanoid
 
@@ -28,7 +28,7 @@ class RunContext:
     humanoid: Humanoid | None = None
     artifacts: dict[str, Any] = field(default_factory=dict)
     metrics: dict[str, float] = field(default_factory=dict)
-    checks: list[CheckResult] = field(default_factory=list)
+    checks: list[ThresholdResult] = field(default_factory=list)
     info: dict[str, Any] = field(default_factory=dict)
     outputs: dict[str, str] = field(default_factory=dict)
 

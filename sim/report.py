@@ -8,11 +8,11 @@ joint limit, how much force the floor cannot explain. Thresholds are drawn as da
 from __future__ import annotations
 
 import csv
-import json
 from pathlib import Path
 
 import numpy as np
 
+from avatar_models.fileio import write_json
 from sim.plausibility import PlausibilityReport
 
 
@@ -27,14 +27,6 @@ def write_csv(report: PlausibilityReport, path: Path) -> Path:
         writer = csv.writer(fh)
         writer.writerow(columns)
         writer.writerows(np.column_stack([np.asarray(c, dtype=float) for c in columns.values()]))
-    return path
-
-
-def write_json(report: PlausibilityReport, path: Path) -> Path:
-    def plain(x):
-        return x.item() if isinstance(x, np.generic) else str(x)
-
-    path.write_text(json.dumps(report.contract(), indent=1, default=plain))
     return path
 
 
@@ -94,6 +86,6 @@ def write_outputs(report: PlausibilityReport, out_dir: Path) -> dict[str, Path]:
     out_dir.mkdir(parents=True, exist_ok=True)
     return {
         "csv": write_csv(report, out_dir / "check.csv"),
-        "json": write_json(report, out_dir / "check.json"),
+        "json": write_json(out_dir / "check.json", report.contract()),
         "plot": write_plot(report, out_dir / "check.png"),
     }

@@ -9,12 +9,12 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 from pathlib import Path
 
 import numpy as np
 
 from avatar_models.body17 import BODY17
+from avatar_models.fileio import write_json
 from sim.tracking import TrackingResult
 
 
@@ -47,11 +47,6 @@ def write_csv(result: TrackingResult, path: Path) -> Path:
     writer.writerow(columns)
     writer.writerows(np.column_stack(list(columns.values())).tolist())
     Path(path).write_text(buffer.getvalue())
-    return Path(path)
-
-
-def write_json(summary: dict, path: Path) -> Path:
-    Path(path).write_text(json.dumps(summary, indent=1, allow_nan=False))
     return Path(path)
 
 
@@ -105,6 +100,6 @@ def write_outputs(
     out_dir.mkdir(parents=True, exist_ok=True)
     return {
         "csv": write_csv(result, out_dir / "tracking.csv"),
-        "json": write_json(summary, out_dir / "tracking.json"),
+        "json": write_json(out_dir / "tracking.json", summary),
         "plot": write_plot(result, out_dir / "tracking.png", title),
     }

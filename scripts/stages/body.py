@@ -6,8 +6,8 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from avatar_models.fileio import write_atomic
 from avatar_models.formats import save_motion
-from scripts.results import write_atomic
 from scripts.run_context import RunContext
 from sim.humanoid import humanoid_for
 from sim.replay import replay_kinematic

@@ -9,9 +9,9 @@ import cv2
 import imageio.v3 as iio
 import numpy as np
 
+from avatar_models.fileio import write_atomic
 from render_cams.kinect.depth import colourise, read_depth_png
 from render_cams.kinect.sensors import get_sensor
-from scripts.results import write_atomic
 from scripts.run_context import RunContext
 from scripts.scenario import Scenario
 

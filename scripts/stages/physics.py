@@ -6,7 +6,7 @@ scenario's ``[physics]`` table; each thresholded value becomes a check row of th
 
 from __future__ import annotations
 
-from scripts.results import CheckResult
+from scripts.results import ThresholdResult
 from scripts.run_context import RunContext
 from scripts.scenario import Threshold
 from sim.plausibility import CONTRACT_KEYS, check_humanoid
@@ -29,7 +29,7 @@ def run(ctx: RunContext) -> None:
     for row in report.thresholds:
         ctx.metrics[row["name"]] = float(row["value"])
         ctx.checks.append(
-            CheckResult(row["name"], float(row["value"]), Threshold(max=row["threshold"]))
+            ThresholdResult(row["name"], float(row["value"]), Threshold(max=row["threshold"]))
         )
     ctx.info["physics"] = {k: report.values.get(k) for k in CONTRACT_KEYS} | {
         "passed": report.passed

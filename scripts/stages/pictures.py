@@ -7,7 +7,7 @@ import cv2
 import imageio.v3 as iio
 import numpy as np
 
-from scripts.results import write_atomic
+from avatar_models.fileio import write_atomic
 from scripts.run_context import RunContext
 from sim.humanoid import Humanoid
 from sim.render import render_frames

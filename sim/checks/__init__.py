@@ -5,27 +5,27 @@ line here (and its definition and threshold in :mod:`sim.thresholds`).
 """
 
 from sim.checks.base import Check, CheckResult
-from sim.checks.contact import FootContact
-from sim.checks.floating import Floating
-from sim.checks.jitter import Jitter
-from sim.checks.joint_limits import JointLimits
-from sim.checks.penetration import Penetration
+from sim.checks.contact import FootContactCheck
+from sim.checks.floating import FloatingCheck
+from sim.checks.jitter import JitterCheck
+from sim.checks.joint_limits import JointLimitCheck
+from sim.checks.penetration import PenetrationCheck
 from sim.checks.replay import BodyReplay
-from sim.checks.residual import ResidualForce
-from sim.checks.self_collision import SelfCollision
-from sim.checks.skating import Skating
-from sim.checks.support import Balance
+from sim.checks.residual import ResidualForceCheck
+from sim.checks.self_collision import SelfCollisionCheck
+from sim.checks.skating import SkatingCheck
+from sim.checks.support import BalanceCheck
 
 ALL_CHECKS: tuple[Check, ...] = (
-    FootContact(),
-    Penetration(),
-    Floating(),
-    Skating(),
-    JointLimits(),
-    SelfCollision(),
-    Jitter(),
-    Balance(),
-    ResidualForce(),
+    FootContactCheck(),
+    PenetrationCheck(),
+    FloatingCheck(),
+    SkatingCheck(),
+    JointLimitCheck(),
+    SelfCollisionCheck(),
+    JitterCheck(),
+    BalanceCheck(),
+    ResidualForceCheck(),
 )
 
 __all__ = ["ALL_CHECKS", "BodyReplay", "Check", "CheckResult"]

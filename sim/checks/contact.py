@@ -12,7 +12,7 @@ from sim.checks.replay import BodyReplay
 from sim.thresholds import CheckConfig
 
 
-class FootContact:
+class FootContactCheck:
     name = "contact"
 
     def __call__(self, replay: BodyReplay, config: CheckConfig) -> CheckResult:

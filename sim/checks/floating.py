@@ -14,7 +14,7 @@ from sim.checks.replay import BodyReplay
 from sim.thresholds import CheckConfig
 
 
-class Floating:
+class FloatingCheck:
     name = "floating"
 
     def __call__(self, replay: BodyReplay, config: CheckConfig) -> CheckResult:

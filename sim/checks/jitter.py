@@ -13,7 +13,7 @@ from sim.checks.replay import BodyReplay
 from sim.thresholds import CheckConfig
 
 
-class Jitter:
+class JitterCheck:
     name = "jitter"
 
     def __call__(self, replay: BodyReplay, config: CheckConfig) -> CheckResult:

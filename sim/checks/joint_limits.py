@@ -68,7 +68,7 @@ def _excess_deg(angle: np.ndarray, ranges: np.ndarray) -> np.ndarray:
     return np.degrees(np.maximum(np.maximum(lo - angle, angle - hi), 0.0))
 
 
-class JointLimits:
+class JointLimitCheck:
     name = "joint_limits"
 
     def __call__(self, replay: BodyReplay, config: CheckConfig) -> CheckResult:

@@ -9,7 +9,7 @@ from sim.checks.replay import BodyReplay
 from sim.thresholds import CheckConfig
 
 
-class Penetration:
+class PenetrationCheck:
     name = "penetration"
 
     def __call__(self, replay: BodyReplay, config: CheckConfig) -> CheckResult:

@@ -79,7 +79,7 @@ def root_force(
     return force
 
 
-class ResidualForce:
+class ResidualForceCheck:
     name = "residual_force"
 
     def __call__(self, replay: BodyReplay, config: CheckConfig) -> CheckResult:

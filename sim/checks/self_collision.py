@@ -16,7 +16,7 @@ from sim.checks.replay import BodyReplay
 from sim.thresholds import CheckConfig
 
 
-class SelfCollision:
+class SelfCollisionCheck:
     name = "self_collision"
 
     def __call__(self, replay: BodyReplay, config: CheckConfig) -> CheckResult:

@@ -62,7 +62,7 @@ def stance_slides(slip: np.ndarray, contact: np.ndarray, fps: float) -> list[np.
     return out
 
 
-class Skating:
+class SkatingCheck:
     name = "skating"
 
     def __call__(self, replay: BodyReplay, config: CheckConfig) -> CheckResult:

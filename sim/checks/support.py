@@ -51,7 +51,7 @@ def outside_margin(points: np.ndarray, active: np.ndarray, p: np.ndarray) -> np.
     return out
 
 
-class Balance:
+class BalanceCheck:
     name = "balance"
 
     def __call__(self, replay: BodyReplay, config: CheckConfig) -> CheckResult:

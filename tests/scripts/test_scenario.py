@@ -6,7 +6,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from scripts.results import CheckResult, junit_xml
+from scripts.results import ThresholdResult, junit_xml
 from scripts.scenario import (
     DEFAULT_SCENARIO,
     ScenarioError,
@@ -64,27 +64,15 @@ def test_threshold_semantics():
 
 
 def test_junit_xml_marks_failures():
-    checks = [CheckResult("a", 0.5, Threshold(max=1.0)), CheckResult("b", 2.0, Threshold(max=1.0))]
+    checks = [
+        ThresholdResult("a", 0.5, Threshold(max=1.0)),
+        ThresholdResult("b", 2.0, Threshold(max=1.0)),
+    ]
     root = ET.fromstring(junit_xml("demo", checks))
     assert root.get("tests") == "2" and root.get("failures") == "1"
     cases = {c.get("name"): c for c in root.iter("testcase")}
     assert cases["a"].find("failure") is None
     assert "2" in cases["b"].find("failure").get("message")
-
-
-def test_results_json_is_strict_json(tmp_path):
-    import json
-    import math
-
-    import numpy as np
-
-    from scripts.results import write_json
-
-    path = write_json(
-        tmp_path / "r.json", {"a": np.float64("nan"), "ok": np.bool_(True), "n": np.int64(3)}
-    )
-    data = json.loads(path.read_text(), parse_constant=lambda c: math.nan)  # would see NaN
-    assert data == {"a": None, "ok": True, "n": 3}
 
 
 def test_non_finite_thresholds_are_rejected():

@@ -11,7 +11,7 @@ from avatar_models import quat
 from avatar_models.body import build_body
 from avatar_models.generator import generate
 from avatar_models.motion import Motion
-from sim.checks.joint_limits import JointLimits
+from sim.checks.joint_limits import JointLimitCheck
 from sim.checks.replay import BodyReplay
 from sim.checks.residual import cone_distance
 from sim.checks.skating import contact_runs, slip_velocity
@@ -181,7 +181,7 @@ def _joint_limits(body, bends_deg: dict[str, tuple[float, str]]):
     m = m.replace(local_rot=rot)
     model = body.model
     replay = BodyReplay.run(body, model, body.qpos_from_motion(m), m.fps, CheckConfig())
-    return JointLimits()(replay, CheckConfig())
+    return JointLimitCheck()(replay, CheckConfig())
 
 
 def test_neck_chain_is_judged_by_its_total_not_by_each_joints_share(rest_body):
