@@ -7,10 +7,10 @@ passes the :class:`Humanoid` along; nothing downstream rebuilds a body from a sk
   body of its own skeleton and its exact qpos (:meth:`BodyDescription.qpos_from_motion`):
   residual zero.
 - Any other rig with a body17 map (Bandai, Kinect...) is retargeted onto the avatar-rig
-  humanoid sized to it (:func:`sim.retarget.humanoid_body`, :func:`sim.retarget.retarget`);
+  humanoid sized to it (:func:`sim.retarget.sizing.humanoid_body`, :func:`sim.retarget.retarget`);
   its per-frame residual is kept.
 
-Physics tracking needs stance feet flat on the floor (:func:`sim.retarget.level_stance_feet`
+Physics tracking needs stance feet flat on the floor (:func:`sim.retarget.feet.level_stance_feet`
 and the repairs around it); :meth:`Humanoid.for_tracking` gives that reference on the same body
 and model, retargeting again only for a foreign rig.
 
@@ -138,7 +138,7 @@ def humanoid_for(
         qpos = body.qpos_from_motion(motion)
         zero = np.zeros(motion.n_frames)
         return Humanoid(body, motion, qpos, zero, motion, body.to_mjcf(), body.model)
-    from sim.retarget import humanoid_body  # IK (mink) is only loaded when needed
+    from sim.retarget.sizing import humanoid_body  # IK (mink) is only loaded when needed
 
     body = humanoid_body(motion, mass_kg=mass_kg)
     return _retargeted(body, motion, body.to_mjcf(), body.model, level_feet)

@@ -13,14 +13,9 @@ from avatar_models.errors import MotionValueError
 from avatar_models.formats import load_motion
 from avatar_models.generator import Subject, generate
 from avatar_models.rigs import body17_positions, load_rig
-from sim.retarget import (
-    SWING_CLEARANCE_M,
-    fitted_body,
-    lift_toes,
-    retarget,
-    stance_feet,
-    swinging_feet,
-)
+from sim.retarget import retarget
+from sim.retarget.feet import SWING_CLEARANCE_M, lift_toes, stance_feet, swinging_feet
+from sim.retarget.sizing import fitted_body
 from sim.soles import box_corners, corner_positions, foot_bodies, sole_boxes
 
 BANDAI_WALK = "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh"

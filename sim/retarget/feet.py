@@ -1,20 +1,6 @@
-"""Retargeting a motion on any rig onto the humanoid by matching body17 positions with IK.
+"""Feet of a retargeted reference that a physics tracker can stand and walk on.
 
-Shapes: ``T`` frames, ``nq`` MuJoCo position coordinates.
-
-Sizing (the choice we made): by default the *humanoid is sized to the source*. The avatar rig
-is rebuilt with one length factor per segment kind (thigh, shank, foot, upper arm, forearm,
-torso, head) so that its body17 distances equal the source's medians over the clip, with
-shoulders and hips placed where the source has them relative to neck and pelvis
-(:func:`fitted_body`). The targets are then the source's body17 positions unchanged, so the
-residual measures what the rigs cannot share (spine curvature, joint ranges), not a size
-mismatch. When a body is given, the *targets are scaled* instead, uniformly about the world
-origin by the ratio of both skeletons' standing heights
-(:func:`avatar_models.measure.standing_height`), so stride length scales with the body.
-
-IK (:class:`avatar_models.body.ik.HumanoidIK`) steers the 17 body17 sites, with joint limits
-from the model and a weak pull towards the rest pose; the residual per frame is the mean
-site-to-target distance.
+Shapes: ``T`` frames, ``nq`` MuJoCo position coordinates; feet ordered (left, right).
 
 Stance feet (:func:`level_stance_feet`): body17 has no foot orientation, so the first IK pass
 leaves a standing foot at whatever pitch joins its ankle and toe targets, often on its toes
@@ -38,22 +24,14 @@ toe joint and would drag on the floor and trip the body.
 
 from __future__ import annotations
 
-from typing import NamedTuple
-
 import mujoco
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from avatar_models import quat
-from avatar_models.body import BodyDescription, build_body
-from avatar_models.body.anatomy import classify
-from avatar_models.body.ik import HumanoidIK, IKSettings, humanoid_model, motion_from_qpos
+from avatar_models.body.ik import HumanoidIK, IKSettings
 from avatar_models.body17 import BODY17, INDEX
-from avatar_models.errors import MotionValueError, RigError
 from avatar_models.foot_contact import contact_mask, horizontal_speed
-from avatar_models.measure import standing_height
-from avatar_models.motion import Motion
-from avatar_models.rigs import body17_positions, load_rig
 from sim.soles import (
     box_corners,
     corner_positions,
@@ -64,7 +42,6 @@ from sim.soles import (
     toe_bodies,
 )
 
-TEMPLATE_RIG = "avatar"
 FOOT_SITES = (("l_ankle", "l_foot"), ("r_ankle", "r_foot"))
 """Per side, the body17 sites on the foot body and on the toe body."""
 STANCE_HEIGHT_M = 0.03
@@ -73,150 +50,6 @@ STANCE_SPEED_M_S = 0.5
 """...and its ankle moves slower than this horizontally (heel strike to toe-off)."""
 FOOT_ORIENTATION_COST = 1.0
 """Weight of a stance foot's flat orientation (per rad²) next to the positions' 1 (per m²)."""
-SEGMENT_SPANS: dict[str, tuple[tuple[str, str], ...]] = {
-    "thigh": (("l_hip", "l_knee"), ("r_hip", "r_knee")),
-    "shank": (("l_knee", "l_ankle"), ("r_knee", "r_ankle")),
-    "foot": (("l_ankle", "l_foot"), ("r_ankle", "r_foot")),
-    "upper_arm": (("l_shoulder", "l_elbow"), ("r_shoulder", "r_elbow")),
-    "forearm": (("l_elbow", "l_wrist"), ("r_elbow", "r_wrist")),
-    "torso": (("pelvis", "neck"),),
-    "head": (("neck", "head"),),
-}
-"""Segment kind -> the body17 distances its length factor sets (sides averaged). In the
-avatar rig each of these distances runs through bones of that one kind only, so one factor
-per kind matches them exactly in the rest pose."""
-
-
-class Retargeted(NamedTuple):
-    """``qpos (T, nq)``, the ``motion`` on the humanoid's skeleton, and ``residual_cm (T,)``
-    (mean body17 site-to-target distance per frame)."""
-
-    qpos: np.ndarray
-    motion: Motion
-    residual_cm: np.ndarray
-
-
-def span_lengths(positions: np.ndarray) -> dict[str, float]:
-    """Median over frames of each :data:`SEGMENT_SPANS` distance in body17 ``positions
-    (T, 17, 3)``, averaged over the sides."""
-    out = {}
-    for kind, spans in SEGMENT_SPANS.items():
-        a = positions[:, [INDEX[s[0]] for s in spans]]
-        b = positions[:, [INDEX[s[1]] for s in spans]]
-        out[kind] = float(np.median(np.linalg.norm(a - b, axis=-1), axis=0).mean())
-    return out
-
-
-GIRDLES: dict[str, tuple[str, str]] = {
-    "neck": ("l_shoulder", "r_shoulder"),
-    "pelvis": ("l_hip", "r_hip"),
-}
-"""Anchor -> the pair of joints hung from it whose rest placement is copied from the source."""
-
-
-def trunk_offsets(positions: np.ndarray, anchor: str) -> np.ndarray:
-    """``(2, 3)`` median position of the :data:`GIRDLES` pair of ``anchor`` relative to the
-    anchor in body17 ``positions (T, 17, 3)``, in a trunk frame (up: pelvis to neck; left:
-    from the right to the left joint of the pair, made orthogonal to up; forward: left x up).
-    In a rest pose standing upright this frame is the world frame."""
-    pair = GIRDLES[anchor]
-    p = {n: positions[:, INDEX[n]] for n in ("pelvis", "neck", anchor, *pair)}
-    up = p["neck"] - p["pelvis"]
-    up /= np.linalg.norm(up, axis=-1, keepdims=True)
-    left = p[pair[0]] - p[pair[1]]
-    left -= np.sum(left * up, axis=-1, keepdims=True) * up
-    left /= np.linalg.norm(left, axis=-1, keepdims=True)
-    frame = np.stack([np.cross(left, up), left, up], axis=1)  # (T, 3 axes, 3)
-    rel = np.stack([p[pair[0]], p[pair[1]]], axis=1) - p[anchor][:, None]
-    return np.median(np.einsum("tab,tkb->tka", frame, rel), axis=0)
-
-
-def fitted_body(motion: Motion, mass_kg: float = 75.0) -> BodyDescription:
-    """The avatar-rig humanoid with each segment kind scaled to ``motion``'s body17
-    distances, shoulders and hips placed as the source's (:func:`trunk_offsets`)."""
-    rig = load_rig(TEMPLATE_RIG)
-    sk = rig.skeleton
-    b17 = rig.body17_indices(sk)
-    rest = sk.rest_positions()[b17]
-    source = body17_positions(motion)
-    ours, theirs = span_lengths(rest[None]), span_lengths(source)
-    scale = {kind: theirs[kind] / ours[kind] for kind in SEGMENT_SPANS}
-    rig_kinds = classify(sk, rig).bone_kind
-    # Shoulders and hips: place each where the source has it relative to the neck or the
-    # pelvis (the avatar's clavicles are bones of kind "torso", so no length factor alone
-    # can set shoulder width and height). Offsets are set before the kind factors apply,
-    # hence the division; the bones between anchor and joint are of that joint's kind.
-    offsets = sk.offsets.copy()
-    rest_all = sk.rest_positions()
-    for anchor, pair in GIRDLES.items():
-        at = rest_all[int(b17[INDEX[anchor]])]
-        for name, rel in zip(pair, trunk_offsets(source, anchor), strict=True):
-            j = int(b17[INDEX[name]])
-            factor = scale.get(rig_kinds[j], 1.0)
-            offsets[j] = rel / factor - (rest_all[sk.parents[j]] - at)
-    return build_body(sk.with_offsets(offsets), mass_kg=mass_kg, segment_scale=scale)
-
-
-def humanoid_body(motion: Motion, mass_kg: float = 75.0) -> BodyDescription:
-    """The body a foreign-rig ``motion`` is retargeted onto: the one that the skeleton of
-    :func:`fitted_body` builds (``build_body(result.motion.skeleton)``, what a caller
-    simulates). fitted_body's own segment scaling also sizes geoms (toe box 1 cm shorter,
-    head, masses), and a reference made for other feet than the simulated ones puts the toes
-    into the floor."""
-    return build_body(fitted_body(motion).skeleton, mass_kg=mass_kg)
-
-
-def retarget(
-    motion: Motion,
-    body: BodyDescription | None = None,
-    settings: IKSettings | None = None,
-    level_feet: bool = False,
-    scale_targets: bool | None = None,
-    model: mujoco.MjModel | None = None,
-) -> Retargeted:
-    """Retarget ``motion`` (any rig with a body17 map) onto ``body`` (default:
-    :func:`humanoid_body`). ``scale_targets`` (default: whether a body was given) scales
-    the targets to the body's standing height; a body made by :func:`humanoid_body` for this
-    motion is already its size. ``model`` is the body's compiled MJCF when the caller has
-    it (it is only read). Joint limits of the body hold in the result. ``level_feet`` puts
-    stance feet flat on the floor and clears swinging ones (module docstring), for physics
-    tracking; off by default, since it trades fidelity for it (Bandai walk normal_001: mean
-    body17 residual 0.03 -> 0.75 cm, p95 2.4 cm), so the physics checks judge the source's own
-    contacts. The body is the one ``build_body(result.motion.skeleton)`` gives, so a
-    reference levelled for these feet is simulated with the same feet.
-
-    Raises:
-        MotionValueError: the motion's rig has no body17 map.
-    """
-    try:
-        targets = body17_positions(motion)
-    except RigError as exc:
-        raise MotionValueError(f"cannot retarget: {exc}") from exc
-    if scale_targets is None:
-        scale_targets = body is not None
-    if body is None:
-        body = humanoid_body(motion)
-    if scale_targets:
-        targets = targets * (standing_height(body.skeleton) / standing_height(motion))
-    model = humanoid_model(body) if model is None else model
-    stance = stance_feet(targets, motion.fps)
-    if level_feet:  # without the floor offset below, flat feet would float (Bandai: 6 cm)
-        targets = match_foot_pitch(model, targets, stance)
-    ik = HumanoidIK(model, BODY17, settings=settings)
-    solved = ik.solve(targets)
-    qpos, residual_cm = solved.qpos, solved.residual_cm
-    if level_feet:
-        offset = sole_offset(model, targets, stance)
-        qpos[:, 2] -= offset
-        targets = targets - [0.0, 0.0, offset]
-        qpos = level_stance_feet(model, qpos, stance, settings)
-        qpos = lift_toes(model, qpos)
-        qpos = clear_swing_feet(model, qpos, swinging_feet(targets, motion.fps) & ~stance)
-        sites = np.stack([ik.frame_positions(q) for q in qpos])
-        residual_cm = 100.0 * np.linalg.norm(sites - targets, axis=-1).mean(axis=1)
-    out = motion_from_qpos(body, qpos, motion.fps)
-    out = out.replace(meta={**motion.meta, "retargeted_from": motion.skeleton.name})
-    return Retargeted(qpos, out, residual_cm)
 
 
 def stance_feet(positions: np.ndarray, fps: float) -> np.ndarray:
