@@ -284,12 +284,12 @@ def test_missing_file_is_a_format_error(tmp_path):
 
 @pytest.mark.parametrize("fmt, newline", [("%.6f", "\n"), ("%.10g", "\r\n"), ("%.3e", "\n")])
 def test_fast_and_checked_frame_parsers_agree_bit_for_bit(tmp_path, fmt, newline):
-    from avatar_models.formats.bvh import _checked_motion_values, _motion_values
+    from avatar_models.formats.bvh.frames import checked_motion_values, motion_values
 
     values = np.random.default_rng(0).normal(scale=100.0, size=(40, 9))
     data = newline.join("\t".join(fmt % v for v in row) for row in values) + newline
-    fast = _motion_values(data, 40, 9, tmp_path / "x.bvh", 1)
-    checked = _checked_motion_values(data, 40, 9, tmp_path / "x.bvh", 1)
+    fast = motion_values(data, 40, 9, tmp_path / "x.bvh", 1)
+    checked = checked_motion_values(data, 40, 9, tmp_path / "x.bvh", 1)
     assert fast.tobytes() == checked.tobytes()
     np.testing.assert_allclose(fast, values, rtol=1e-2 if fmt == "%.3e" else 1e-5, atol=1e-5)
 
