@@ -1,38 +1,5 @@
-"""Acclaim ASF (skeleton) + AMC (motion) reader, as used by the CMU mocap database.
-
-References: the Acclaim ASF/AMC format description (J. Lander, "Working with Motion Capture
-File Formats", Game Developer 1998; mirrored at research.cs.wisc.edu/graphics/Courses/
-cs-838-1999/Jeff/ASF-AMC.html) and the readers it is checked against: CalciferZh/AMCParser
-(``amc_parser.py``) and dm_control's CMU parser (``suite/utils/parse_amc.py``).
-
-Conventions of the ASF, kept here:
-
-- Each bone has a ``direction`` (unit vector in the world rest frame), a ``length`` and an
-  ``axis`` frame ``C`` (Euler angles, order given by the trailing letters, e.g. ``XYZ``; the
-  angles are listed in that order). Per frame the AMC gives Euler angles of a rotation ``M``
-  about ``C``'s axes, in the order of the bone's ``dof`` line (``rx ry rz`` -> x first, then
-  y, then z, i.e. ``M = Rz Ry Rx`` as in amc_parser's ``euler2mat(.., 'sxyz')``).
-- The bone's world rotation is ``G = G_parent C M C^-1``, so its rotation relative to its
-  parent is ``L = C M C^-1``; its tip is ``start + G direction length``.
-
-Mapping onto a :class:`~avatar_models.skeleton.Skeleton` (offsets rotated by the parent's
-rotation, as in BVH): the joint that *rotates* a bone has to sit where the bone starts, so
-joint ``b`` is placed at the start of bone ``b`` (the tip of its parent bone) with
-``L_b = C M C^-1``, its offset is the parent bone's ``direction * length`` (zero for the
-children of ``root``), and every leaf bone ``b`` gets an end site ``b_end`` at its tip. This is
-the layout of the CMU BVH conversions (``LeftUpLeg`` = ``lfemur`` sits at the hip). The
-standard readers report the *tip* of each bone under the bone's name;
-:func:`bone_tip_positions` gives exactly those (the position of a joint's first child or site).
-
-Frames: the ASF's Y-up world (rest pose facing +Z) becomes Z up facing +X with
-``K = [[0,0,1],[1,0,0],[0,1,0]]`` (as the BVH reader): offsets and translations ``K v``,
-rotations ``K L K^T``. Lengths: ``:units length s`` means file values times ``1/s`` are inches,
-so metres = value * (1/s) * 0.0254 (CMU: s = 0.45 -> 0.056444 m per unit).
-
-Limits: ``Skeleton.limits[b]["rx"|"ry"|"rz"]`` are the ASF ranges of ``M``'s Euler angles in
-radians, i.e. about the axes of bone ``b``'s frame ``C``, not of the Z-up world; those axes in
-the Z-up rest frame (the columns of ``K C``) are in ``motion.meta["limit_axes"][b]``.
-"""
+"""The ASF skeleton file: units, root, bone data and hierarchy, and the Z-up
+:class:`~avatar_models.skeleton.Skeleton` it gives (conventions: :mod:`..asf_amc`)."""
 
 from __future__ import annotations
 
@@ -43,21 +10,15 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
 from avatar_models.errors import MotionFormatError, MotionValueError
 from avatar_models.formats.units import UNITS, Y_UP_TO_Z_UP, unit_scale
-from avatar_models.motion import Motion
 from avatar_models.skeleton import Skeleton
-
-CMU_FPS = 120.0  # the CMU database is captured at 120 Hz; AMC files do not say.
 
 _SECTIONS = (":version", ":name", ":units", ":documentation", ":root", ":bonedata", ":hierarchy")
 _REQUIRED = (":units", ":root", ":bonedata", ":hierarchy")
 _ROTATION_DOFS = ("rx", "ry", "rz")
 _ROOT_CHANNELS = ("tx", "ty", "tz", "rx", "ry", "rz")
-_AMC_KEYWORDS = (":fully-specified", ":degrees", ":radians")
 _AXIS_ORDER = re.compile(r"^[xyz]{3}$")
-_CMU_TRIAL = re.compile(r"^(\d+)_\d+$")
 
 
 @dataclass(frozen=True)
@@ -99,7 +60,7 @@ class Asf:
     parent: dict[str, str] = field(default_factory=dict)
 
 
-def _floats(tokens: list[str], n: int, what: str, path: Path, line: int, finite: bool = True):
+def parse_floats(tokens: list[str], n: int, what: str, path: Path, line: int, finite: bool = True):
     """``n`` floats from ``tokens`` or a MotionFormatError naming ``what``."""
     if len(tokens) != n:
         raise MotionFormatError(f"{what} needs {n} numbers, got {len(tokens)}", path, line)
@@ -127,7 +88,6 @@ def _axis_order(token: str, path: Path, line: int) -> str:
     return order
 
 
-# -- ASF ----------------------------------------------------------------------------------
 def _read_lines(path: Path) -> list[tuple[int, list[str]]]:
     """Non-blank, non-comment lines as ``(1-based line number, tokens)``."""
     try:
@@ -172,7 +132,7 @@ def _parse_units(path: Path, body) -> dict[str, str | float]:
     for line, tokens in body:
         key = tokens[0].lower()
         if key in ("mass", "length"):
-            (value,) = _floats(tokens[1:], 1, f"units {key}", path, line)
+            (value,) = parse_floats(tokens[1:], 1, f"units {key}", path, line)
             if value <= 0:
                 raise MotionFormatError(f"units {key} must be positive, got {value}", path, line)
             units[key] = float(value)
@@ -205,9 +165,9 @@ def _parse_root(path: Path, body, to_rad: float):
     if len(axis_tokens) != 1:
         raise MotionFormatError("root axis must be one order string such as XYZ", path, line)
     axis_order = _axis_order(axis_tokens[0], path, line)
-    position = _floats(fields["position"][1], 3, "root position", path, fields["position"][0])
+    position = parse_floats(fields["position"][1], 3, "root position", path, fields["position"][0])
     line, orient_tokens = fields["orientation"]
-    orientation = _floats(orient_tokens, 3, "root orientation", path, line)
+    orientation = parse_floats(orient_tokens, 3, "root orientation", path, line)
     return order, _euler_frame(orientation, axis_order, to_rad), position
 
 
@@ -245,15 +205,17 @@ def _parse_bone(path: Path, begin_line: int, body, to_rad: float) -> AsfBone:
     if len(name_tokens) != 1:
         raise MotionFormatError("bone name must be one word", path, line)
     name = name_tokens[0]
-    direction = _floats(
+    direction = parse_floats(
         fields["direction"][1], 3, f"{name} direction", path, fields["direction"][0]
     )
-    (length,) = _floats(fields["length"][1], 1, f"{name} length", path, fields["length"][0])
+    (length,) = parse_floats(fields["length"][1], 1, f"{name} length", path, fields["length"][0])
     line, axis_tokens = fields["axis"]
     if len(axis_tokens) != 4:
         raise MotionFormatError(f"{name} axis needs 3 angles and an order such as XYZ", path, line)
     axis_order = _axis_order(axis_tokens[3], path, line)
-    axis = _euler_frame(_floats(axis_tokens[:3], 3, f"{name} axis", path, line), axis_order, to_rad)
+    axis = _euler_frame(
+        parse_floats(axis_tokens[:3], 3, f"{name} axis", path, line), axis_order, to_rad
+    )
     dofs: tuple[str, ...] = ()
     if "dof" in fields:
         line, dof_tokens = fields["dof"]
@@ -268,7 +230,7 @@ def _parse_bone(path: Path, begin_line: int, body, to_rad: float) -> AsfBone:
     limits = []
     for line, tokens in limit_rows:
         inner = " ".join(tokens).replace("(", " ").replace(")", " ").replace(",", " ").split()
-        lo, hi = _floats(inner, 2, f"{name} limits", path, line, finite=False)
+        lo, hi = parse_floats(inner, 2, f"{name} limits", path, line, finite=False)
         if lo > hi:
             raise MotionFormatError(f"{name} limits ({lo}, {hi}) are reversed", path, line)
         limits.append((float(lo * to_rad), float(hi * to_rad)))
@@ -433,214 +395,3 @@ def asf_skeleton(asf: Asf) -> tuple[Skeleton, dict[str, np.ndarray]]:
     except MotionValueError as exc:
         raise MotionFormatError(f"invalid skeleton: {exc}", asf.path) from None
     return skeleton, frames
-
-
-# -- AMC ----------------------------------------------------------------------------------
-def _amc_rows(path: Path) -> tuple[list[tuple[int, str, str]], str | None]:
-    """Data rows ``(line, head, rest)`` after the header, and the header's angle unit if any."""
-    try:
-        text = path.read_bytes().decode("utf-8", errors="replace")
-    except OSError as exc:
-        raise MotionFormatError(f"cannot read: {exc.strerror}", path) from None
-    rows = []
-    angle = None
-    for i, raw in enumerate(text.splitlines(), start=1):
-        parts = raw.split(None, 1)
-        if not parts or parts[0].startswith("#"):
-            continue
-        if parts[0].startswith(":"):
-            key = parts[0].lower()
-            if rows or key not in _AMC_KEYWORDS or len(parts) > 1:
-                raise MotionFormatError(f"unexpected AMC keyword line {raw.strip()!r}", path, i)
-            angle = {":degrees": "deg", ":radians": "rad"}.get(key, angle)
-            continue
-        rows.append((i, parts[0], parts[1] if len(parts) > 1 else ""))
-    if not rows:
-        raise MotionFormatError("no frames (empty or truncated file)", path)
-    return rows, angle
-
-
-def _channel_values(
-    path: Path, lines: list[int], rests: list[str], n: int, what: str
-) -> np.ndarray:
-    """``(len(lines), n)`` floats of one bone's rows; errors name the first bad line."""
-    tokens = [r.split() for r in rests]
-    counts = np.fromiter(map(len, tokens), dtype=np.int64, count=len(tokens))
-    bad = np.flatnonzero(counts != n)
-    if bad.size:
-        k = bad[0]
-        raise MotionFormatError(f"{what} needs {n} values, got {counts[k]}", path, lines[k])
-    try:
-        values = np.array(tokens, dtype=float).reshape(len(lines), n)
-    except ValueError:
-        # Find the offending row for the message; numpy rejects a few spellings Python's
-        # float() takes (e.g. "1_0"), so fall back to the first row when none is found.
-        for line, toks in zip(lines, tokens, strict=True):
-            _floats(toks, n, what, path, line)
-        raise MotionFormatError(f"{what}: unparsable number", path, lines[0]) from None
-    bad = np.flatnonzero(~np.isfinite(values).all(axis=1))
-    if bad.size:
-        raise MotionFormatError(f"{what}: NaN or infinite value", path, lines[bad[0]])
-    return values
-
-
-def read_amc_channels(
-    path: str | Path, asf: Asf
-) -> tuple[np.ndarray, dict[str, np.ndarray], str | None]:
-    """Frame numbers ``(T,)`` and per-bone DOF values ``{bone: (T, n_dof)}`` in file units.
-
-    ``"root"`` holds the ASF root ``order`` channels. Bones absent in a frame read as zeros.
-    Also returns the angle unit the AMC header declares (``:DEGREES``/``:RADIANS``) or None.
-    """
-    path = Path(path)
-    rows, angle = _amc_rows(path)
-    line_no = [r[0] for r in rows]
-    heads = [r[1] for r in rows]
-    # A frame line is a lone integer (ASCII digits only: str.isdigit also accepts e.g. "²").
-    is_frame = np.array(
-        [
-            h.isascii() and h.isdigit() and len(h) < 10 and not r[2]
-            for h, r in zip(heads, rows, strict=True)
-        ]
-    )
-    if not is_frame[0]:
-        raise MotionFormatError(f"expected a frame number, got {heads[0]!r}", path, line_no[0])
-    frame_rows = np.flatnonzero(is_frame)
-    numbers = np.array([int(heads[i]) for i in frame_rows])
-    jumps = np.flatnonzero(np.diff(numbers) != 1)
-    if jumps.size:
-        k = frame_rows[jumps[0] + 1]
-        raise MotionFormatError(
-            f"frame {heads[k]} out of sequence (after {numbers[jumps[0]]})", path, line_no[k]
-        )
-    frame_of_row = np.cumsum(is_frame) - 1
-    n_frames = numbers.size
-    grouped: dict[str, list[int]] = {}
-    for i in np.flatnonzero(~is_frame):
-        grouped.setdefault(heads[i], []).append(int(i))
-    dof_count = {"root": len(asf.root_order)} | {b: len(v.dofs) for b, v in asf.bones.items()}
-    for head, idx in grouped.items():
-        if head not in dof_count:
-            raise MotionFormatError(
-                f"unknown bone {head!r} (not in the ASF)", path, line_no[idx[0]]
-            )
-    rows_per_frame = np.bincount(frame_of_row[~is_frame], minlength=n_frames)
-    if np.any(rows_per_frame == 0):
-        k = frame_rows[np.argmax(rows_per_frame == 0)]
-        raise MotionFormatError(f"frame {heads[k]} has no data (truncated file?)", path, line_no[k])
-    channels = {}
-    for bone, n in dof_count.items():
-        idx = grouped.get(bone, [])
-        frames = frame_of_row[idx]
-        dup = np.flatnonzero(np.diff(frames) == 0)
-        if dup.size:
-            raise MotionFormatError(
-                f"{bone} given twice in one frame", path, line_no[idx[dup[0] + 1]]
-            )
-        values = np.zeros((n_frames, n))
-        if idx:
-            lines = [line_no[i] for i in idx]
-            values[frames] = _channel_values(path, lines, [rows[i][2] for i in idx], n, bone)
-        channels[bone] = values
-    return numbers, channels, angle
-
-
-def _rotations(angles: np.ndarray, dofs: tuple[str, ...], frame: np.ndarray) -> np.ndarray:
-    """``(T, 3, 3)`` ``F M F^T`` for Euler ``angles (T, k)`` (radians) about ``dofs`` of ``F``."""
-    if not dofs:
-        return np.broadcast_to(np.eye(3), (angles.shape[0], 3, 3))
-    m = Rotation.from_euler("".join(d[1] for d in dofs), angles).as_matrix()
-    return frame @ m.reshape(-1, 3, 3) @ frame.T
-
-
-def find_asf(amc_path: str | Path) -> Path:
-    """The ASF beside ``amc_path``: same stem, or the subject's ``SS.asf`` for CMU ``SS_TT.amc``."""
-    amc_path = Path(amc_path)
-    stems = [amc_path.stem]
-    trial = _CMU_TRIAL.match(amc_path.stem)
-    if trial:
-        stems.append(trial.group(1))
-    for stem in stems:
-        for suffix in (".asf", ".ASF"):
-            candidate = amc_path.with_name(stem + suffix)
-            if candidate.is_file():
-                return candidate
-    raise MotionFormatError(
-        f"no skeleton beside it: put its ASF file in the same folder, named "
-        f"{' or '.join(s + '.asf' for s in stems)} (from Python: read_asf_amc(path, asf=...))",
-        amc_path,
-    )
-
-
-def read_asf_amc(
-    amc_path: str | Path,
-    asf: str | Path | None = None,
-    unit: str | float = "asf",
-    fps: float = CMU_FPS,
-) -> Motion:
-    """Read an AMC motion with its ASF skeleton into a Z-up, metre :class:`Motion`.
-
-    Args:
-        amc_path: the ``.amc`` file.
-        asf: the ``.asf`` file; by default found beside the AMC (:func:`find_asf`).
-        unit: ``"asf"`` (use the ASF's ``:units length``), a unit name or metres per unit.
-        fps: frame rate; AMC files do not store one (CMU: 120).
-
-    ``meta`` records ``source``, ``asf``, ``format``, ``metres_per_unit``, ``first_frame``,
-    ``asf_name`` and ``limit_axes`` (see the module docstring).
-    """
-    amc_path = Path(amc_path)
-    asf_path = find_asf(amc_path) if asf is None else Path(asf)
-    if not asf_path.is_file():
-        raise MotionFormatError("no such ASF file", asf_path)
-    if not (isinstance(fps, int | float) and np.isfinite(fps) and fps > 0):
-        raise MotionFormatError(f"fps must be a positive number, got {fps!r}", amc_path)
-    skel_data = read_asf(asf_path, unit)
-    skeleton, frames = asf_skeleton(skel_data)
-    numbers, channels, amc_angle = read_amc_channels(amc_path, skel_data)
-    angle = amc_angle or skel_data.units["angle"]
-    to_rad = np.pi / 180.0 if angle == "deg" else 1.0
-
-    n = numbers.size
-    local = np.broadcast_to(np.eye(3), (n, skeleton.n_joints, 3, 3)).copy()
-    root = channels["root"]
-    order = skel_data.root_order
-    rot_cols = [i for i, c in enumerate(order) if c[0] == "r"]
-    local[:, 0] = _rotations(
-        root[:, rot_cols] * to_rad, tuple(order[i] for i in rot_cols), frames["root"]
-    )
-    for name, bone in skel_data.bones.items():
-        if bone.dofs:
-            j = skeleton.index(name)
-            local[:, j] = _rotations(channels[name] * to_rad, bone.dofs, frames[name])
-    translation = np.zeros((n, 3))
-    for i, c in enumerate(order):
-        if c[0] == "t":
-            translation[:, "xyz".index(c[1])] = root[:, i]
-    root_pos = (translation + skel_data.root_position) @ Y_UP_TO_Z_UP.T * skel_data.metres_per_unit
-    meta = {
-        "source": str(amc_path),
-        "format": "amc",
-        "asf": str(asf_path),
-        "asf_name": skel_data.name,
-        "metres_per_unit": skel_data.metres_per_unit,
-        "first_frame": int(numbers[0]),
-        "limit_axes": {j: frames[j].tolist() for j in skeleton.limits},
-    }
-    try:
-        return Motion(skeleton, fps, root_pos, quat.from_matrix(local), meta)
-    except MotionValueError as exc:
-        raise MotionFormatError(f"invalid motion: {exc}", amc_path) from None
-
-
-def bone_tip_positions(motion: Motion) -> np.ndarray:
-    """``(T, J, 3)`` the tip of the bone each joint rotates (an ASF reader's bone position).
-
-    For an ASF-derived skeleton all children of a joint start at its bone's tip, so the tip is
-    the position of the first child; sites and childless joints give their own position.
-    """
-    parents = motion.skeleton.parents
-    first_child = np.arange(motion.skeleton.n_joints)
-    for j in range(len(parents) - 1, 0, -1):  # reverse, so the lowest-index child wins
-        first_child[parents[j]] = j
-    return motion.global_positions()[:, first_child]
