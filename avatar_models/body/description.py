@@ -159,7 +159,6 @@ class BodyDescription:
     def to_mjcf(self) -> str:
         """MJCF XML of this body standing on a floor, for MuJoCo's viewer (MuJoCo writes 6
         significant digits: :attr:`model` is compiled from the spec, not from this text)."""
-        self.model  # noqa: B018  (MuJoCo writes XML from a compiled spec)
         return self.spec.to_xml()
 
     def qpos_from_motion(self, motion: Motion) -> np.ndarray:

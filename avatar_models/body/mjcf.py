@@ -46,6 +46,12 @@ PLACEHOLDER_INERTIA = 1e-8
 LEG_ROLES = ("pelvic_girdle", "hip", "knee", "ankle", "toe")
 AXIS_VECTORS = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 SEGMENT_RGBA = (0.8, 0.6, 0.45, 1.0)
+TEXTURES = (
+    ("grid", "2D", "CHECKER", 512, (0.2, 0.3, 0.4), (0.3, 0.4, 0.5)),
+    ("sky", "SKYBOX", "GRADIENT", 256, (0.55, 0.65, 0.75), (0.1, 0.12, 0.15)),
+)
+"""Name, kind (``mjTEXTURE_*``), pattern (``mjBUILTIN_*``), size in pixels and two colours
+of the floor's and the sky's textures."""
 GEOM_SHAPES = {
     "capsule": mujoco.mjtGeom.mjGEOM_CAPSULE,
     "sphere": mujoco.mjtGeom.mjGEOM_SPHERE,
@@ -163,26 +169,18 @@ def _set_defaults(spec: mujoco.MjSpec) -> None:
 
 def _add_scenery(spec: mujoco.MjSpec) -> None:
     """The checkered floor, the sky and the sun."""
-    spec.add_texture(
-        name="grid",
-        type=mujoco.mjtTexture.mjTEXTURE_2D,
-        builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
-        width=512,
-        height=512,
-        rgb1=[0.2, 0.3, 0.4],
-        rgb2=[0.3, 0.4, 0.5],
-    )
+    for name, kind, pattern, size, rgb1, rgb2 in TEXTURES:
+        spec.add_texture(
+            name=name,
+            type=getattr(mujoco.mjtTexture, f"mjTEXTURE_{kind}"),
+            builtin=getattr(mujoco.mjtBuiltin, f"mjBUILTIN_{pattern}"),
+            width=size,
+            height=size,
+            rgb1=rgb1,
+            rgb2=rgb2,
+        )
     material = spec.add_material(name="grid", texrepeat=[8.0, 8.0])
     material.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = "grid"
-    spec.add_texture(
-        name="sky",
-        type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
-        builtin=mujoco.mjtBuiltin.mjBUILTIN_GRADIENT,
-        width=256,
-        height=256,
-        rgb1=[0.55, 0.65, 0.75],
-        rgb2=[0.1, 0.12, 0.15],
-    )
     # A 1024 shadow map (MuJoCo's default is 4096) is plenty for the report's few-hundred-pixel
     # pictures and halves the software (llvmpipe) render time per frame.
     spec.visual.quality.shadowsize = 1024

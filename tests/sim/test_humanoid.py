@@ -38,8 +38,13 @@ def test_own_rig_is_exact_and_not_retargeted():
     trace = replay_kinematic(h.model, h.qpos)
     pelvis = h.model.body(walk.skeleton.names[0]).id
     assert np.allclose(trace.body_pos[:, pelvis], walk.global_positions()[:, 0], atol=1e-9)
-    # The compiled model is the MJCF's.
+    # The model is the body's, compiled once from its spec; the MJCF is that spec's text.
+    assert h.model is h.body.model and h.spec is h.body.spec
     assert h.model.nq == h.qpos.shape[1] and "<mujoco" in h.mjcf
+    # The control variant is compiled anew: motors, and the shared model is left as it is.
+    control = h.control_model()
+    assert control is not h.model and not control.actuator_ctrllimited.any()
+    assert h.model.actuator_ctrllimited.all()
     assert h.for_tracking() is h  # own feet: nothing to level
 
 
