@@ -74,12 +74,12 @@ def body_spec(desc: BodyDescription) -> mujoco.MjSpec:
     """A new spec of ``desc``: floor, lights, the body, actuators, tendons, contact
     exclusions. The caller owns it (edit a :meth:`~mujoco.MjSpec.copy` of a shared one)."""
     spec = _spec_without_exclusions(desc)
-    for a, b in adjacent_bodies(desc, spec):
+    for a, b in _adjacent_bodies(desc, spec):
         spec.add_exclude(bodyname1=a, bodyname2=b)
     return spec
 
 
-def adjacent_bodies(desc: BodyDescription, spec: mujoco.MjSpec) -> list[tuple[str, str]]:
+def _adjacent_bodies(desc: BodyDescription, spec: mujoco.MjSpec) -> list[tuple[str, str]]:
     """Body pairs of ``spec`` that must not collide, sorted: parent and child (ankle and toes
     included), and pairs whose geoms already touch in the rest pose (thighs at the crotch,
     bodies joined by zero-length bones).
