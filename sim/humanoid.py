@@ -44,7 +44,6 @@ class Humanoid:
         residual_cm: ``(T,)`` mean body17 site-to-target distance of the retargeting (zeros
             for an own rig).
         source: the motion as given (after any height scaling).
-        mjcf: the body's MJCF text (MuJoCo's export of ``body.spec``, for its viewer).
         model: ``body.spec`` compiled once (:attr:`BodyDescription.model`), shared by every
             stage: read it, do not edit it (physics control compiles its own variant,
             :meth:`control_model`).
@@ -56,13 +55,18 @@ class Humanoid:
     qpos: np.ndarray
     residual_cm: np.ndarray
     source: Motion
-    mjcf: str
     model: mujoco.MjModel
     levelled: bool = False
 
     @property
     def retargeted(self) -> bool:
         return self.motion is not self.source
+
+    @property
+    def mjcf(self) -> str:
+        """The body's MJCF text (MuJoCo's export of ``body.spec``, for its viewer), written
+        when asked for."""
+        return self.body.to_mjcf()
 
     @property
     def spec(self) -> mujoco.MjSpec:
@@ -137,23 +141,23 @@ def humanoid_for(
     else:
         qpos = body.qpos_from_motion(motion)
         zero = np.zeros(motion.n_frames)
-        return Humanoid(body, motion, qpos, zero, motion, body.to_mjcf(), body.model)
+        return Humanoid(body, motion, qpos, zero, motion, body.model)
     from sim.retarget.sizing import humanoid_body  # IK (mink) is only loaded when needed
 
     body = humanoid_body(motion, mass_kg=mass_kg)
-    return _retargeted(body, motion, body.to_mjcf(), body.model, level_feet)
+    return _retargeted(body, motion, body.model, level_feet)
 
 
 def _retargeted(
-    body: BodyDescription, motion: Motion, mjcf: str, model: mujoco.MjModel, level_feet: bool
+    body: BodyDescription, motion: Motion, model: mujoco.MjModel, level_feet: bool
 ) -> Humanoid:
     from sim.retarget import retarget
 
     result = retarget(motion, body, level_feet=level_feet, scale_targets=False, model=model)
     meta = {**result.motion.meta, "retarget_residual_cm": float(np.mean(result.residual_cm))}
     out = result.motion.replace(meta=meta)
-    return Humanoid(body, out, result.qpos, result.residual_cm, motion, mjcf, model, level_feet)
+    return Humanoid(body, out, result.qpos, result.residual_cm, motion, model, level_feet)
 
 
 def _levelled(h: Humanoid) -> Humanoid:
-    return _retargeted(h.body, h.source, h.mjcf, h.model, level_feet=True)
+    return _retargeted(h.body, h.source, h.model, level_feet=True)
