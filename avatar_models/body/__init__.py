@@ -11,8 +11,15 @@ primitives posed for one frame. MuJoCo is imported only in
 """
 
 from avatar_models.body.description import BodyDescription, build_body
-from avatar_models.body.errors import BodyError
+from avatar_models.body.errors import BodyError, RestPoseNotUprightError
 from avatar_models.body.geometry import Segment
 from avatar_models.body.mjcf import hinge_name
 
-__all__ = ["BodyDescription", "BodyError", "Segment", "build_body", "hinge_name"]
+__all__ = [
+    "BodyDescription",
+    "BodyError",
+    "RestPoseNotUprightError",
+    "Segment",
+    "build_body",
+    "hinge_name",
+]
