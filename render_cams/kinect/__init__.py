@@ -4,7 +4,8 @@ and 30 Hz skeleton streams (issue 4, item 6).
 - :mod:`.sensors`: depth modes (size, field of view, range) with sources.
 - :mod:`.noise`: axial/lateral depth noise, flying pixels, invalid pixels.
 - :mod:`.depth`: depth frames and body-index maps rendered from a ``BodyScene``; PNG writers.
-- :mod:`.skeleton`: joints on the kinect_v2 / azure_kinect rigs, tracking state, noise.
+- :mod:`.rig_joints`: joints and orientations of the kinect_v2 / azure_kinect rigs on a motion.
+- :mod:`.skeleton`: the skeleton stream: tracking state, noise.
 - :mod:`.sequence`: a whole recording on disk (depth, body index, skeleton JSON, preview).
 """
 
