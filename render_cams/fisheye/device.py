@@ -78,7 +78,7 @@ class FisheyeRecording:
     fps_rendered: float
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class FisheyeRig:
     """The controller cameras and how they record.
 
@@ -213,13 +213,7 @@ class FisheyeRig:
             "seed": seed,
             "model": model.as_dict(),
         }
+        fps_rendered = n_frames * n_cams / max(elapsed, 1e-9)
         return FisheyeRecording(
-            cameras=tuple(cameras),
-            names=names,
-            model=model,
-            images=images,
-            range_mm=range_mm,
-            records=records,
-            summary=summary,
-            fps_rendered=n_frames * n_cams / max(elapsed, 1e-9),
+            tuple(cameras), names, model, images, range_mm, records, summary, fps_rendered
         )
