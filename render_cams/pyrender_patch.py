@@ -44,17 +44,15 @@ OVERRIDDEN = {
     "_configure_main_framebuffer": ("self",),
     "_read_main_framebuffer": ("self", "scene", "flags"),
 }
-ATTRIBUTES = {
-    pyrender.Renderer: (
-        "_main_fb",
-        "_main_fb_dims",
-        "_main_fb_ms",
-        "_main_cb_ms",
-        "_main_db_ms",
-        "_program_cache",
-    ),
-    pyrender.OffscreenRenderer: ("_renderer", "_platform"),
-}
+RENDERER_ATTRIBUTES = (
+    "_main_fb",
+    "_main_fb_dims",
+    "_main_fb_ms",
+    "_main_cb_ms",
+    "_main_db_ms",
+    "_program_cache",
+)  # of a pyrender.Renderer, set in its constructor (which makes no GL calls)
+OFFSCREEN_ATTRIBUTES = ("_renderer", "_platform")  # of a pyrender.OffscreenRenderer
 EGL_ATTRIBUTES = ("_egl_display", "_egl_context")  # of pyrender.platforms.egl.EGLPlatform
 
 
@@ -69,8 +67,8 @@ def pyrender_version() -> str:
 
 
 def _assigned_in(cls: type, attribute: str) -> bool:
-    """Whether ``cls``'s source assigns ``self.<attribute>`` (instance attributes exist only
-    on objects, and making one needs a GL context)."""
+    """Whether ``cls``'s source assigns ``self.<attribute>`` (for classes whose objects need a
+    GL context to be made)."""
     return f"self.{attribute} =" in inspect.getsource(cls)
 
 
@@ -85,10 +83,14 @@ def missing_private_names() -> tuple[str, ...]:
             missing.append(f"Renderer.{name} (method gone)")
         elif tuple(inspect.signature(method).parameters) != params:
             missing.append(f"Renderer.{name} (parameters changed, expected {params})")
-    for cls, names in ATTRIBUTES.items():
-        missing += [
-            f"{cls.__name__}.{n} (attribute gone)" for n in names if not _assigned_in(cls, n)
-        ]
+    renderer = vars(pyrender.Renderer(1, 1))
+    missing += [f"Renderer.{n} (attribute gone)" for n in RENDERER_ATTRIBUTES if n not in renderer]
+    offscreen = pyrender.OffscreenRenderer
+    missing += [
+        f"OffscreenRenderer.{n} (attribute gone)"
+        for n in OFFSCREEN_ATTRIBUTES
+        if not _assigned_in(offscreen, n)
+    ]
     from pyrender.platforms.egl import EGLPlatform
 
     missing += [

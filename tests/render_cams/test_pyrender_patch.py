@@ -30,7 +30,7 @@ def test_a_removed_method_is_named_with_the_pyrender_version(monkeypatch, fresh_
 
 def test_a_changed_signature_and_a_missing_attribute_are_reported(monkeypatch, fresh_check):
     monkeypatch.setattr(pyrender.Renderer, "_configure_main_framebuffer", lambda self, extra: 0)
-    monkeypatch.setattr(pyrender_patch, "ATTRIBUTES", {pyrender.Renderer: ("_no_such_buffer",)})
+    monkeypatch.setattr(pyrender_patch, "RENDERER_ATTRIBUTES", ("_no_such_buffer",))
     missing = missing_private_names()
     assert any(m.startswith("Renderer._configure_main_framebuffer (parameters") for m in missing)
     assert "Renderer._no_such_buffer (attribute gone)" in missing
