@@ -1,9 +1,12 @@
 """``Kinect``: a Kinect V2 or Azure Kinect depth sensor with body tracking as one ``Device``.
 
 ``Kinect(sensor).sample(motion, seed, body) -> KinectRecording`` records ``motion`` at the
-sensor's 30 Hz, in memory: depth and body-index frames (:mod:`.depth`, one segmentation pass
-plus the depth noise model of :mod:`.noise`) and the skeleton stream (:mod:`.skeleton`).
-:func:`render_cams.kinect.sequence.write_kinect_recording` writes a recording to a folder.
+sensor's 30 Hz: the skeleton stream (:mod:`.skeleton`) and the self-describing record in
+memory, and the depth and body-index frames (:mod:`.depth`, one segmentation pass plus the
+depth noise model of :mod:`.noise`) as :class:`DepthFrames`, rendered as they are read, so
+that a long take streams to disk in constant memory (a 600 s Azure Kinect take would hold
+20 GB). :func:`render_cams.kinect.sequence.write_kinect_recording` writes a recording to a
+folder.
 
 One seed drives both noises: the skeleton noise uses it as it is, the depth noise the stream
 ``[seed, 1]``.
@@ -11,6 +14,7 @@ One seed drives both noises: the skeleton noise uses it as it is, the depth nois
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -19,7 +23,7 @@ import numpy as np
 from avatar_models import Motion
 from avatar_models.body import BodyDescription
 from render_cams.device import motion_at_rate, resolve_seed
-from render_cams.kinect.depth import BODY_INDEX_NONE, KinectDepthCamera
+from render_cams.kinect.depth import BODY_INDEX_NONE, DepthFrame, KinectDepthCamera
 from render_cams.kinect.placement import (
     DEFAULT_HEIGHT_M,
     default_sensor_pose,
@@ -31,13 +35,48 @@ from render_cams.scene import BodyScene, body_for_motion
 
 
 @dataclass(frozen=True, eq=False)
+class DepthFrames:
+    """The ``T`` depth frames of a take, rendered in order as they are iterated.
+
+    Every pass starts the depth noise from the same seed, so every pass yields the same
+    frames; :meth:`stack` holds them all at once.
+
+    Attributes:
+        motion: the take at the sensor's rate, on ``body``'s skeleton.
+        body: the humanoid to render.
+        camera: the posed depth camera and its noise model.
+        seed: the seed of the depth noise (stream ``[seed, 1]``).
+    """
+
+    motion: Motion
+    body: BodyDescription
+    camera: KinectDepthCamera
+    seed: int
+
+    def __len__(self) -> int:
+        return self.motion.n_frames
+
+    def __iter__(self) -> Iterator[DepthFrame]:
+        rng = np.random.default_rng([self.seed, 1])  # the skeleton noise uses seed itself
+        with BodyScene(self.body) as scene:
+            for t in range(self.motion.n_frames):
+                scene.update(self.motion, t)
+                yield self.camera.capture(scene, rng)
+
+    def stack(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(T, H, W)`` uint16 depth in millimetres (0: no reading) and ``(T, H, W)`` uint8
+        body-index maps (0: body, 255: no body)."""
+        frames = list(self)
+        return np.stack([f.depth_mm for f in frames]), np.stack([f.body_index for f in frames])
+
+
+@dataclass(frozen=True, eq=False)
 class KinectRecording:
     """What a Kinect recorded: ``T`` frames of ``H x W`` pixels, ``J`` rig joints.
 
     Attributes:
         sensor: the depth sensor (mode, K, range).
-        depth_mm: ``(T, H, W)`` uint16 depth in millimetres (0: no reading).
-        body_index: ``(T, H, W)`` uint8 body-index maps (0: body, 255: no body).
+        frames: the ``T`` depth and body-index frames (``(H, W)`` each), rendered when read.
         skeleton: the ``(T, J)`` skeleton stream.
         camera_to_world: ``(4, 4)`` sensor pose (OpenCV camera axes).
         record: the self-describing summary (device, K, D, image size, poses, seed, tracked
@@ -45,8 +84,7 @@ class KinectRecording:
     """
 
     sensor: DepthSensor
-    depth_mm: np.ndarray
-    body_index: np.ndarray
+    frames: DepthFrames
     skeleton: KinectSkeletonStream
     camera_to_world: np.ndarray
     record: dict[str, Any]
@@ -112,16 +150,9 @@ class Kinect:
         )
         used_seed = resolve_seed(seed)
         skeleton = kinect_skeleton(sampled, sensor, pose, used_seed, self.skeleton_noise, body)
-        camera = KinectDepthCamera(sensor, pose, self.depth_noise)
-        rng = np.random.default_rng([used_seed, 1])  # the skeleton noise uses used_seed itself
-        shape = (sampled.n_frames, sensor.height, sensor.width)
-        depth_mm = np.zeros(shape, np.uint16)
-        body_index = np.zeros(shape, np.uint8)
-        with BodyScene(body) as scene:
-            for t in range(sampled.n_frames):
-                scene.update(sampled, t)
-                frame = camera.capture(scene, rng)
-                depth_mm[t], body_index[t] = frame.depth_mm, frame.body_index
+        frames = DepthFrames(
+            sampled, body, KinectDepthCamera(sensor, pose, self.depth_noise), used_seed
+        )
         states = skeleton.states
         record = {
             "device": sensor.name,
@@ -146,4 +177,4 @@ class Kinect:
             "depth_unit": "mm",
             "body_index_none": BODY_INDEX_NONE,
         }
-        return KinectRecording(sensor, depth_mm, body_index, skeleton, pose, record)
+        return KinectRecording(sensor, frames, skeleton, pose, record)

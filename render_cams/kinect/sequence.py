@@ -43,14 +43,12 @@ def write_kinect_recording(recording: KinectRecording, out_dir: str | Path) -> d
         sensor.rate_hz,
         (sensor.width, sensor.height),
     )
-    for t, (depth_mm, body_index) in enumerate(
-        zip(recording.depth_mm, recording.body_index, strict=True)
-    ):
+    for t, frame in enumerate(recording.frames):  # rendered one by one: constant memory
         name = f"{t:06d}"
-        write_png(depth_mm, out / "depth" / f"{name}.png")
-        write_png(body_index, out / "body_index" / f"{name}.png")
+        write_png(frame.depth_mm, out / "depth" / f"{name}.png")
+        write_png(frame.body_index, out / "body_index" / f"{name}.png")
         (out / "skeleton" / f"{name}.json").write_text(skeleton.to_json(t))
-        video.write(_preview(depth_mm, skeleton, t, sensor))
+        video.write(_preview(frame.depth_mm, skeleton, t, sensor))
     video.release()
     record = {**recording.record, "preview": video_path.name}
     (out / "recording.json").write_text(json.dumps(record, indent=1, sort_keys=True))

@@ -9,7 +9,7 @@ import cv2
 import imageio.v3 as iio
 import numpy as np
 
-from render_cams.kinect.depth import colourise
+from render_cams.kinect.depth import colourise, read_depth_png
 from scripts.results import write_atomic
 from scripts.run_context import RunContext
 from scripts.scenario import Scenario
@@ -78,10 +78,9 @@ def run(ctx: RunContext) -> None:
         t0 = time.perf_counter()
         recording = Kinect(spec.kinect).sample(clip, ctx.scenario.seed, body)
         write_kinect_recording(recording, folder)
-        ctx.metrics["kinect_fps_rendered"] = recording.depth_mm.shape[0] / (
-            time.perf_counter() - t0
-        )
-        bgr = colourise(recording.depth_mm[0], recording.sensor.range_m)
+        ctx.metrics["kinect_fps_rendered"] = len(recording.frames) / (time.perf_counter() - t0)
+        first = read_depth_png(folder / "depth" / "000000.png")
+        bgr = colourise(first, recording.sensor.range_m)
         panels.append(panel(bgr[..., ::-1], f"{spec.kinect} depth"))
         ctx.output("kinect_recording", folder / "recording.json")
     if panels:
