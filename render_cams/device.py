@@ -9,14 +9,15 @@ the seed actually used is recorded in the output. The devices, one module each:
 - :class:`render_cams.vr.setup.VRSetup` -> :class:`~render_cams.tracking.TrackingStream`
   (``(T, D, 3)`` positions, ``(T, D, 4)`` quaternions of ``D`` trackers);
 - :class:`render_cams.kinect.device.Kinect` -> :class:`~render_cams.kinect.device.KinectRecording`
-  (``(T, H, W)`` depth and body index, the ``(T, J)`` skeleton stream);
+  (the ``(T, J)`` skeleton stream, ``T`` depth and body-index frames of ``(H, W)``, rendered
+  as they are read so that long takes stream);
 - :class:`render_cams.fisheye.device.FisheyeRig` ->
   :class:`~render_cams.fisheye.device.FisheyeRecording` (``(C, T, H, W, 3)`` images,
   ``(C, T, H, W)`` range, ``C * T`` keypoint records).
 
 Devices that see the body's surface (the cameras) also take ``body=``, the humanoid built once
 for the motion, so that nothing rebuilds it; the trackers follow joints and need none.
-Recordings live in memory; each camera's ``sequence`` module writes one to a folder.
+Each camera's ``sequence`` module writes a recording to a folder.
 """
 
 from __future__ import annotations
