@@ -1,9 +1,23 @@
 """``Device``: the small protocol every simulated device follows, plus its shared helpers.
 
-A device turns a ground-truth :class:`~avatar_models.Motion` into what the hardware would
-report: ``device.sample(motion, seed) -> stream``. It has a ``name`` and a sampling rate
-``rate_hz`` (90 Hz for VR tracking, 30 Hz for a Kinect). Randomness comes from one seed or
-``numpy.random.Generator`` per call; the seed actually used is recorded in the output.
+A device is constructed from its options and turns a ground-truth :class:`~avatar_models.Motion`
+into what the hardware would report: ``device.sample(motion, seed) -> recording``. It has a
+``name`` and a sampling rate ``rate_hz`` (90 Hz for VR tracking, 30 Hz for Kinect and the
+controller cameras). Randomness comes from one seed or ``numpy.random.Generator`` per call;
+the seed actually used is recorded in the output. The devices, one module each:
+
+- :class:`render_cams.vr.setup.VRSetup` -> :class:`~render_cams.tracking.TrackingStream`
+  (``(T, D, 3)`` positions, ``(T, D, 4)`` quaternions of ``D`` trackers);
+- :class:`render_cams.kinect.device.Kinect` -> :class:`~render_cams.kinect.device.KinectRecording`
+  (the ``(T, J)`` skeleton stream, ``T`` depth and body-index frames of ``(H, W)``, rendered
+  as they are read so that long takes stream);
+- :class:`render_cams.fisheye.device.FisheyeRig` ->
+  :class:`~render_cams.fisheye.device.FisheyeRecording` (``(C, T, H, W, 3)`` images,
+  ``(C, T, H, W)`` range, ``C * T`` keypoint records).
+
+Devices that see the body's surface (the cameras) also take ``body=``, the humanoid built once
+for the motion, so that nothing rebuilds it; the trackers follow joints and need none.
+Each camera's ``sequence`` module writes a recording to a folder.
 """
 
 from __future__ import annotations
@@ -21,13 +35,13 @@ class DeviceError(AvatarsimError, ValueError):
 
 @runtime_checkable
 class Device(Protocol):
-    """What a simulated device offers: a name, a rate and ``sample``."""
+    """What a simulated device offers: a name, a rate and ``sample`` (cameras add ``body=``)."""
 
     name: str
     rate_hz: float
 
     def sample(self, motion: Motion, seed: int | np.random.Generator = 0) -> Any:
-        """The device's output stream for ``motion``; same motion + seed => same bytes."""
+        """The device's recording of ``motion``; same motion + seed => same bytes."""
         ...
 
 

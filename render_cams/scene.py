@@ -6,7 +6,8 @@ merged into ONE mesh (per-vertex colours, and per-vertex part labels in ``texcoo
 is posed by transforming its vertices: pyrender spends ~0.2 ms of Python per drawn primitive,
 so one draw call instead of ~25 per view.
 
-Passes (one GL context per scene, single-sampled unless ``antialias=True``):
+Passes (one GL context per scene, single-sampled unless ``antialias=True``; what this takes
+from pyrender's private API is isolated in :mod:`render_cams.pyrender_patch`):
 
 - :meth:`BodyScene.render`: colour and depth, with a diffuse-only shader
   (``shaders/matte.frag``; ``shading="pbr"`` keeps pyrender's physically based one);
@@ -37,14 +38,13 @@ from pathlib import Path
 import numpy as np
 import pyrender
 import trimesh
-from OpenGL import GL
-from pyrender.shader_program import ShaderProgramCache
 
 import avatar_models  # noqa: F401  (picks the OpenGL backend before pyrender loads)
 from avatar_models import AvatarsimError, Motion, quat
 from avatar_models.body import BodyDescription, build_body
 from avatar_models.body.mesh import mesh_template
 from avatar_models.skeleton import Skeleton
+from render_cams.pyrender_patch import close_renderer, open_renderer
 
 # OpenCV camera axes (x right, y down, z forward) -> pyrender/OpenGL (x right, y up, z back).
 CV_TO_GL = np.diag([1.0, -1.0, -1.0, 1.0])
@@ -181,95 +181,6 @@ def body_for_motion(motion: Motion, body: BodyDescription | None = None) -> Body
     return body
 
 
-class _BodyProgramCache(ShaderProgramCache):
-    """pyrender's shader cache with BodyScene's shaders swapped in: the label pass always, the
-    matte colour shader when asked."""
-
-    def __init__(self, matte: bool):
-        super().__init__()
-        self._swaps = {"segmentation.vert": LABELS_VERT, "segmentation.frag": LABELS_FRAG}
-        if matte:
-            self._swaps["mesh.frag"] = MATTE_SHADER
-
-    def get_program(self, vertex_shader, fragment_shader, geometry_shader=None, defines=None):
-        # Absolute paths: pyrender's os.path.join keeps them as they are.
-        vertex_shader = str(self._swaps.get(vertex_shader, vertex_shader))
-        fragment_shader = str(self._swaps.get(fragment_shader, fragment_shader))
-        return super().get_program(vertex_shader, fragment_shader, geometry_shader, defines)
-
-
-class _BodyRenderer(pyrender.Renderer):
-    """pyrender's renderer with BodyScene's shaders, single-sampled unless ``antialias``.
-
-    pyrender always renders into a 4x multisampled framebuffer; giving its buffers one sample
-    makes every pass sample pixel centres (and is cheaper in software rendering).
-    """
-
-    def __init__(self, width: int, height: int, matte: bool, antialias: bool):
-        super().__init__(width, height)
-        self._program_cache = _BodyProgramCache(matte)
-        self.antialias = antialias
-
-    def _configure_main_framebuffer(self):
-        size = (self.viewport_width, self.viewport_height)
-        fresh = self._main_fb is None or self._main_fb_dims != size
-        super()._configure_main_framebuffer()
-        if fresh and not self.antialias:
-            layouts = ((self._main_cb_ms, GL.GL_RGBA), (self._main_db_ms, GL.GL_DEPTH_COMPONENT24))
-            for buffer, layout in layouts:
-                GL.glBindRenderbuffer(GL.GL_RENDERBUFFER, buffer)
-                GL.glRenderbufferStorage(GL.GL_RENDERBUFFER, layout, *size)
-
-    def _read_main_framebuffer(self, scene, flags):
-        """pyrender's read-back, reading a single-sampled framebuffer directly (no blit) and
-        linearising depth in one vectorised pass (pyrender's boolean indexing cost about as
-        much as drawing a Kinect frame)."""
-        if self.antialias:
-            return super()._read_main_framebuffer(scene, flags)
-        width, height = self._main_fb_dims
-        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, self._main_fb_ms)
-        buffer = GL.glReadPixels(0, 0, width, height, GL.GL_DEPTH_COMPONENT, GL.GL_FLOAT)
-        window = np.frombuffer(buffer, np.float32).reshape(height, width)[::-1]
-        camera = scene.main_camera_node.camera
-        near, far = np.float32(camera.znear), np.float32(camera.zfar)
-        # Window depth d in [0, 1] -> camera z = 2 n f / (f + n - (2 d - 1)(f - n)); 1: no hit.
-        depth = (2 * near * far) / ((far + near) - (2 * window - 1) * (far - near))
-        depth[window == 1.0] = 0.0
-        if flags & pyrender.RenderFlags.DEPTH_ONLY:
-            return depth
-        buffer = GL.glReadPixels(0, 0, width, height, GL.GL_RGB, GL.GL_UNSIGNED_BYTE)
-        return np.frombuffer(buffer, np.uint8).reshape(height, width, 3)[::-1], depth
-
-
-class _Contexts:
-    """Opens and closes the scenes' GL contexts. With EGL every context lives on one shared
-    display, and pyrender's ``OffscreenRenderer.delete`` terminates that display
-    (``eglTerminate``), killing every other context on it: other scenes' (``EGL_BAD_DISPLAY``)
-    and MuJoCo's, whose EGL module initialises the display once at import and then fails with
-    ``EGL_NOT_INITIALIZED`` (the pictures rendered after the cameras in a scenario). So a scene
-    destroys only its own context and leaves the display initialised."""
-
-    @staticmethod
-    def open(width: int, height: int, matte: bool, antialias: bool):
-        offscreen = pyrender.OffscreenRenderer(width, height)
-        offscreen._renderer = _BodyRenderer(width, height, matte, antialias)  # no GL state yet
-        return offscreen
-
-    @staticmethod
-    def close(offscreen: pyrender.OffscreenRenderer) -> None:
-        platform = offscreen._platform
-        if getattr(platform, "_egl_display", None) is None:
-            offscreen.delete()  # a platform without a shared display (OSMesa)
-            return
-        from OpenGL.EGL import eglDestroyContext
-
-        platform.make_current()
-        offscreen._renderer.delete()
-        eglDestroyContext(platform._egl_display, platform._egl_context)
-        platform._egl_context = platform._egl_display = None
-        offscreen._renderer = offscreen._platform = None
-
-
 class BodyScene:
     """The posed body (and floor, lights, optional room) ready to render from any camera.
 
@@ -391,6 +302,14 @@ class BodyScene:
         self.set_pose(positions[0], rotations[0])
 
     # -- rendering ----------------------------------------------------------------------
+    def _shader_swaps(self) -> dict[str, Path]:
+        """pyrender shader file -> ours: the label pass always, the matte colour shader when
+        asked."""
+        swaps = {"segmentation.vert": LABELS_VERT, "segmentation.frag": LABELS_FRAG}
+        if self.shading == "matte":
+            swaps["mesh.frag"] = MATTE_SHADER
+        return swaps
+
     def _prepare(
         self, camera_to_world: np.ndarray, K: np.ndarray, width: int, height: int
     ) -> pyrender.OffscreenRenderer:
@@ -408,7 +327,7 @@ class BodyScene:
         # One renderer (one GL context) per scene: pyrender binds meshes to a single context.
         # A new size only resizes its framebuffer.
         if self._renderer is None:
-            self._renderer = _Contexts.open(width, height, self.shading == "matte", self.antialias)
+            self._renderer = open_renderer(width, height, self._shader_swaps(), self.antialias)
         self._renderer.viewport_width, self._renderer.viewport_height = width, height
         return self._renderer
 
@@ -443,7 +362,7 @@ class BodyScene:
     def close(self) -> None:
         """Release this scene's OpenGL context (other scenes keep theirs)."""
         if self._renderer is not None:
-            _Contexts.close(self._renderer)
+            close_renderer(self._renderer)
             self._renderer = None
 
     def __enter__(self) -> BodyScene:

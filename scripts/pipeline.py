@@ -20,6 +20,7 @@ from scripts.results import ThresholdResult, atomic_dir, junit_xml, versions
 from scripts.run_context import RunContext
 from scripts.scenario import Scenario, ScenarioError
 from scripts.stages import STAGES, physics
+from sim.thresholds import ConfigError
 
 METRICS: dict[str, str] = {k: v for stage in STAGES for k, v in stage.METRICS.items()}
 
@@ -49,7 +50,7 @@ def validate(scenario: Scenario) -> None:
         )
     try:
         physics.config(scenario.physics)
-    except Exception as exc:  # a typed ConfigError; re-raised as the scenario's problem
+    except ConfigError as exc:  # re-raised as the scenario's problem
         raise ScenarioError(f"[physics]: {exc}") from exc
 
 

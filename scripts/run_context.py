@@ -9,6 +9,7 @@ from typing import Any
 from rich.console import Console
 
 from avatar_models.motion import Motion
+from render_cams.tracking import TrackingStream
 from scripts.results import ThresholdResult
 from scripts.scenario import Scenario
 from sim.humanoid import Humanoid
@@ -16,17 +17,28 @@ from sim.humanoid import Humanoid
 
 @dataclass
 class RunContext:
-    """Filled stage by stage. ``motion`` is the ground truth; ``humanoid`` its body, built
-    once (stage ``body``) and used by every later stage. ``metrics`` are thresholded by
-    ``[thresholds]``; ``checks`` hold rows a stage judged itself (e.g. physics checks with
-    their own thresholds)."""
+    """Filled stage by stage; each stage's products are typed fields, named after them.
+
+    Attributes:
+        motion: the ground truth (stage ``motion``; ``body`` rescales it to ``[body]``).
+        humanoid: its body, built once (stage ``body``) and used by every later stage.
+        vr_stream: the simulated VR tracking stream (stage ``devices``; None without
+            ``[devices] vr``), the synthesisers' input.
+        synthesised: each method's output on the humanoid, by method name (stage
+            ``synthesis``; empty without ``[synthesis]``).
+        metrics: thresholded by ``[thresholds]``.
+        checks: rows a stage judged itself (e.g. physics checks with their own thresholds).
+        info: per-stage summaries written to ``results.json``.
+        outputs: written files by key, relative to ``out_dir``.
+    """
 
     scenario: Scenario
     out_dir: Path
     console: Console
     motion: Motion | None = None
     humanoid: Humanoid | None = None
-    artifacts: dict[str, Any] = field(default_factory=dict)
+    vr_stream: TrackingStream | None = None
+    synthesised: dict[str, Humanoid] = field(default_factory=dict)
     metrics: dict[str, float] = field(default_factory=dict)
     checks: list[ThresholdResult] = field(default_factory=list)
     info: dict[str, Any] = field(default_factory=dict)

@@ -2,7 +2,9 @@
 
 Each generator returns a new :class:`Motion` on the same skeleton; the plausibility check
 responsible for that defect must flag it (``tests/sim/test_corrupt.py``). Units: metres,
-degrees only in argument names that say so.
+degrees only in argument names that say so. :func:`corrupt` applies one by the name of the
+check that flags it; ``avatarsim check MOTION --corrupt DEFECT`` runs it on a user's motion,
+to see that check fail.
 """
 
 from __future__ import annotations
@@ -64,3 +66,33 @@ def add_jitter(motion: Motion, rng: np.random.Generator, sigma_m: float = 0.01) 
     jitter as a noisy pose estimator produces."""
     noise = rng.normal(0.0, sigma_m, size=motion.root_pos.shape)
     return motion.replace(root_pos=motion.root_pos + noise)
+
+
+DEFECTS = ("penetration", "floating", "joint_limits", "skating", "jitter")
+"""The defects, named as the checks that flag them."""
+
+
+def corrupt(
+    defect: str,
+    motion: Motion,
+    body: BodyDescription,
+    stance: np.ndarray,
+    rng: np.random.Generator,
+) -> Motion:
+    """``motion`` with ``defect`` at each generator's default size (10 cm sunk, 15 cm up,
+    knee 40 degrees past its limit, 20 cm slide per stance of ``stance (T,)``, 1 cm jitter).
+
+    Raises:
+        ValueError: an unknown defect.
+    """
+    if defect == "penetration":
+        return sink_feet(motion)
+    if defect == "floating":
+        return float_body(motion)
+    if defect == "joint_limits":
+        return bend_knee(motion, body)
+    if defect == "skating":
+        return inject_sliding(motion, stance)
+    if defect == "jitter":
+        return add_jitter(motion, rng)
+    raise ValueError(f"unknown defect {defect!r}; defects: {', '.join(DEFECTS)}")

@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from avatar_models.body import BodyDescription, BodyError, build_body, control_spec
+from avatar_models.body import BodyDescription, RestPoseNotUprightError, build_body, control_spec
 from avatar_models.errors import MotionValueError
 from avatar_models.measure import standing_height
 from avatar_models.motion import Motion
@@ -135,9 +135,8 @@ def humanoid_for(
         )
     try:
         body = build_body(motion.skeleton, mass_kg=mass_kg)
-    except BodyError as exc:
-        if "not upright" not in str(exc):
-            raise
+    except RestPoseNotUprightError:
+        pass  # a rig whose rest pose lies down (Bandai's): retargeted onto one that stands
     else:
         qpos = body.qpos_from_motion(motion)
         zero = np.zeros(motion.n_frames)

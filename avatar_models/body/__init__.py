@@ -13,8 +13,16 @@ and ``to_trimesh(...)`` the same primitives posed for one frame. MuJoCo is impor
 
 from avatar_models.body.control import control_spec
 from avatar_models.body.description import BodyDescription, build_body
-from avatar_models.body.errors import BodyError
+from avatar_models.body.errors import BodyError, RestPoseNotUprightError
 from avatar_models.body.geometry import Segment
 from avatar_models.body.mjcf import hinge_name
 
-__all__ = ["BodyDescription", "BodyError", "Segment", "build_body", "control_spec", "hinge_name"]
+__all__ = [
+    "BodyDescription",
+    "BodyError",
+    "RestPoseNotUprightError",
+    "Segment",
+    "build_body",
+    "control_spec",
+    "hinge_name",
+]

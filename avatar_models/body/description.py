@@ -19,7 +19,7 @@ import numpy as np
 
 from avatar_models.body import anthropometry as anthro
 from avatar_models.body.anatomy import Anatomy, classify
-from avatar_models.body.errors import BodyError
+from avatar_models.body.errors import BodyError, RestPoseNotUprightError
 from avatar_models.body.geometry import Segment
 from avatar_models.body.joint_ranges import euler_order, is_shared, joint_ranges
 from avatar_models.body.layout import Layout
@@ -274,7 +274,7 @@ def _check_upright(skeleton: Skeleton, anatomy: Anatomy) -> None:
         path = set(skeleton.chain(head)) ^ set(skeleton.chain(ankle))
         rise = rest[head, 2] - rest[ankle, 2]
         if rise < UPRIGHT_RATIO * lengths[list(path)].sum():
-            raise BodyError(
+            raise RestPoseNotUprightError(
                 f"the rest pose of skeleton {skeleton.name!r} is not upright (head "
                 f"{rise:.3f} m above the {side} ankle along {lengths[list(path)].sum():.3f} m "
                 "of bones); the body needs a rest pose that stands, Z up"

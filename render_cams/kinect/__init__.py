@@ -4,10 +4,13 @@ and 30 Hz skeleton streams (issue 4, item 6).
 - :mod:`.sensors`: depth modes (size, field of view, range) with sources.
 - :mod:`.noise`: axial/lateral depth noise, flying pixels, invalid pixels.
 - :mod:`.depth`: depth frames and body-index maps rendered from a ``BodyScene``; PNG writers.
-- :mod:`.skeleton`: joints on the kinect_v2 / azure_kinect rigs, tracking state, noise.
-- :mod:`.sequence`: a whole recording on disk (depth, body index, skeleton JSON, preview).
+- :mod:`.rig_joints`: joints and orientations of the kinect_v2 / azure_kinect rigs on a motion.
+- :mod:`.skeleton`: the skeleton stream: tracking state, noise.
+- :mod:`.device`: the ``Kinect`` device and its in-memory ``KinectRecording``.
+- :mod:`.sequence`: a recording on disk (depth, body index, skeleton JSON, preview).
 """
 
+from render_cams.kinect.device import Kinect, KinectRecording
 from render_cams.kinect.noise import DepthNoiseModel
 from render_cams.kinect.placement import (
     KinectPlacementError,
@@ -16,6 +19,7 @@ from render_cams.kinect.placement import (
     yaw_pitch_pose,
 )
 from render_cams.kinect.sensors import SENSORS, DepthSensor, KinectError, get_sensor
+from render_cams.kinect.sequence import write_kinect_recording
 from render_cams.kinect.skeleton import (
     KinectSkeletonStream,
     SkeletonNoise,
@@ -27,14 +31,17 @@ __all__ = [
     "SENSORS",
     "DepthNoiseModel",
     "DepthSensor",
+    "Kinect",
     "KinectError",
     "KinectPlacementError",
+    "KinectRecording",
     "KinectSkeletonStream",
     "SkeletonNoise",
     "TrackingState",
     "default_sensor_pose",
     "get_sensor",
     "kinect_skeleton",
+    "write_kinect_recording",
     "look_at",
     "yaw_pitch_pose",
 ]

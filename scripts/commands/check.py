@@ -1,9 +1,11 @@
 """``avatarsim check MOTION``: physics plausibility of a motion on the humanoid.
 
 Prints the summary table, writes per-frame CSV, the contract JSON and a plot into ``--out``,
-optionally the MJCF and keyframes for MuJoCo's viewer into ``--export``. Exit 1 when a
-threshold fails, 2 for bad input (NaN, no frames, unknown rig). A foreign rig is retargeted
-onto the humanoid (:func:`sim.humanoid.humanoid_for`) and its residual reported.
+optionally the MJCF and keyframes for MuJoCo's viewer into ``--export``. ``--corrupt DEFECT``
+first makes the motion wrong in one known way (:mod:`sim.corrupt`), so that the check for it
+fails: a quick way to see what each check catches. Exit 1 when a threshold fails, 2 for bad
+input (NaN, no frames, unknown rig). A foreign rig is retargeted onto the humanoid
+(:func:`sim.humanoid.humanoid_for`) and its residual reported.
 """
 
 from __future__ import annotations
@@ -27,6 +29,18 @@ from scripts.cli_common import (
 )
 
 
+def corrupted(humanoid, clean_report, defect: str, seed: int):
+    """The humanoid of its motion made wrong by ``defect`` (stances from the clean report)."""
+    import numpy as np
+
+    from sim.corrupt import corrupt
+    from sim.humanoid import humanoid_for
+
+    stance = clean_report.per_frame()["contact_left"] > 0
+    rng = np.random.default_rng(seed)
+    return humanoid_for(corrupt(defect, humanoid.motion, humanoid.body, stance, rng))
+
+
 def register(app: typer.Typer) -> None:
     @app.command()
     @user_errors
@@ -44,11 +58,23 @@ def register(app: typer.Typer) -> None:
         config: Annotated[
             Path | None, typer.Option(help="TOML with definitions/thresholds to override.")
         ] = None,
+        corrupt: Annotated[
+            str | None,
+            typer.Option(
+                help="Make the motion wrong first, in the way one check flags: penetration, "
+                "floating, joint_limits, skating or jitter (that check must then fail)."
+            ),
+        ] = None,
         unit: Annotated[str | None, typer.Option(help="File unit (see `info`).")] = None,
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
     ) -> None:
         """Physics plausibility of a motion on the MuJoCo humanoid. Exit 1 if a check fails."""
+        from avatar_models.errors import AvatarsimError
+        from sim.corrupt import DEFECTS
+
+        if corrupt is not None and corrupt not in DEFECTS:
+            raise AvatarsimError(f"--corrupt {corrupt!r}: defects are {', '.join(DEFECTS)}")
         check_outputs(json_out=json_out, out=out, export=export)
         from sim.humanoid import humanoid_for
         from sim.plausibility import check_humanoid
@@ -59,6 +85,10 @@ def register(app: typer.Typer) -> None:
         m = load_motion_arg(motion, unit, seed, min_frames=MIN_FRAMES)
         humanoid = humanoid_for(m)
         report = check_humanoid(humanoid, cfg)
+        if corrupt is not None:
+            humanoid = corrupted(humanoid, report, corrupt, seed)
+            report = check_humanoid(humanoid, cfg)
+            report.meta["corrupt"] = corrupt
         report.meta.update(path=str(motion), seed=seed)
         table = Table(title=f"physics plausibility: {escape(motion)}")
         for col in ("check", "value", "threshold", "passed"):

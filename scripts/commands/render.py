@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 import time
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 from rich.markup import escape
@@ -142,6 +142,92 @@ def _frame_range(
     return start_s, float(end)
 
 
+def _device_option(kind: type, help: str) -> Any:
+    """An optional device option of type ``kind`` (None when not given)."""
+    return Annotated[kind | None, typer.Option(help=help)]
+
+
+def _fisheye_rig(options: dict[str, Any]):
+    """The ``FisheyeRig`` the fisheye options describe (checked before any motion loads)."""
+    from avatar_models.errors import AvatarsimError
+    from render_cams.fisheye.device import FisheyeRig
+    from render_cams.fisheye.model import FisheyeModel
+    from render_cams.fisheye.rig import Mount
+
+    fov_deg = _pair(options["--fov"], "--fov", (150, 120))
+    size_px = _pair(options["--size"], "--size", (640, 480), int)
+    if not all(0 < v < 180 for v in fov_deg):
+        raise AvatarsimError(
+            f"--fov: a FOV must be two angles in (0, 180) degrees, got {options['--fov']!r}"
+        )
+    lo, hi = SIZE_RANGE
+    if not all(lo <= v <= hi for v in size_px):
+        raise AvatarsimError(
+            f"--size must be two sides of {lo}-{hi} pixels, got {options['--size']!r}"
+        )
+    default = Mount()
+    ring_pitch, grip_pitch = options["--ring-pitch"], options["--grip-pitch"]
+    mount = Mount(
+        ring_offset_m=_numbers(options["--ring-offset"], "--ring-offset", 3)
+        or default.ring_offset_m,
+        grip_offset_m=_numbers(options["--grip-offset"], "--grip-offset", 3)
+        or default.grip_offset_m,
+        ring_pitch_rad=default.ring_pitch_rad if ring_pitch is None else _rad(ring_pitch),
+        grip_pitch_rad=default.grip_pitch_rad if grip_pitch is None else _rad(grip_pitch),
+    )
+    return FisheyeRig(model=FisheyeModel.from_fov(*fov_deg, *size_px), mount=mount)
+
+
+def _kinect_placement(options: dict[str, Any]) -> tuple[tuple | None, Any, float]:
+    """``(position, camera_to_world, height)`` from the Kinect options: the pose is None for
+    the automatic set-up (at ``height``) and for a position aimed at the performer (then
+    ``position`` is set; the pose follows from the motion)."""
+    from render_cams.kinect.placement import (
+        DEFAULT_HEIGHT_M,
+        KinectPlacementError,
+        look_at,
+        yaw_pitch_pose,
+    )
+
+    pos_xyz = _numbers(options["--sensor-pos"], "--sensor-pos", 3)
+    look_xyz = _numbers(options["--sensor-look-at"], "--sensor-look-at", 3)
+    yaw, pitch, height = (
+        options["--sensor-yaw"],
+        options["--sensor-pitch"],
+        options["--sensor-height"],
+    )
+    height = DEFAULT_HEIGHT_M if height is None else height
+    if pos_xyz is not None and pos_xyz[2] < 0:
+        raise KinectPlacementError(f"--sensor-pos z = {pos_xyz[2]} m is below the floor")
+    if not (math.isfinite(height) and 0.0 <= height <= 3.0):
+        raise KinectPlacementError(f"--sensor-height must be in [0, 3] m, got {height}")
+    pose = None
+    if yaw is not None or pitch is not None:
+        pose = yaw_pitch_pose(pos_xyz, _rad(yaw or 0.0), _rad(pitch or 0.0))
+    elif look_xyz is not None:
+        pose = look_at(pos_xyz, look_xyz)
+    return pos_xyz, pose, height
+
+
+def _record(device: str, options: dict[str, Any], humanoid, seed: int, out: Path) -> dict:
+    """Record the humanoid's motion with ``device`` (its options were checked before the
+    motion was loaded) into ``out``; return the written recording's summary."""
+    if device == "fisheye":
+        from render_cams.fisheye.sequence import write_fisheye_recording
+
+        recording = _fisheye_rig(options).sample(humanoid.motion, seed, humanoid.body)
+        return write_fisheye_recording(recording, out)
+    from render_cams.kinect.device import Kinect
+    from render_cams.kinect.placement import look_at, performer_target
+    from render_cams.kinect.sequence import write_kinect_recording
+
+    pos_xyz, pose, height = _kinect_placement(options)
+    if pos_xyz is not None and pose is None:  # aimed at the performer
+        pose = look_at(pos_xyz, performer_target(humanoid.motion))
+    kinect = Kinect(device, sensor_pose=pose, sensor_height_m=height)
+    return write_kinect_recording(kinect.sample(humanoid.motion, seed, humanoid.body), out)
+
+
 def register(app: typer.Typer) -> None:
     @app.command()
     @user_errors
@@ -158,61 +244,43 @@ def register(app: typer.Typer) -> None:
             str | None,
             typer.Option(help="Last second of the clip to record, or 'end' (the whole clip)."),
         ] = None,
-        fov: Annotated[
-            str | None, typer.Option(help="fisheye: field of view 'H,V' in degrees (150,120).")
-        ] = None,
-        size: Annotated[
-            str | None,
-            typer.Option(
-                help=f"fisheye: image size 'W,H' in pixels (640,480; {SIZE_RANGE[0]}-"
-                f"{SIZE_RANGE[1]} each)."
-            ),
-        ] = None,
-        ring_offset: Annotated[
-            str | None,
-            typer.Option(
-                help="fisheye: ring camera 'X,Y,Z' in metres in the controller frame "
-                "(+X pointing, +Y left, +Z up; default 0.02,0,0.06)."
-            ),
-        ] = None,
-        grip_offset: Annotated[
-            str | None,
-            typer.Option(help="fisheye: grip camera 'X,Y,Z' in metres (default -0.02,0,-0.06)."),
-        ] = None,
-        ring_pitch: Annotated[
-            float | None,
-            typer.Option(help="fisheye: ring camera pitch in degrees above looking back (32.5)."),
-        ] = None,
-        grip_pitch: Annotated[
-            float | None,
-            typer.Option(help="fisheye: grip camera pitch in degrees (-32.5: looking down)."),
-        ] = None,
-        sensor_pos: Annotated[
-            str | None,
-            typer.Option(
-                help="Kinect: sensor position 'X,Y,Z' in metres (Z up). Default: set up in "
-                "front of the performer, the whole take in range where the sensor allows."
-            ),
-        ] = None,
-        sensor_yaw: Annotated[
-            float | None,
-            typer.Option(help="Kinect: heading of the optical axis in degrees (0 = +X, 90 = +Y)."),
-        ] = None,
-        sensor_pitch: Annotated[
-            float | None,
-            typer.Option(help="Kinect: tilt of the optical axis in degrees (negative: down)."),
-        ] = None,
-        sensor_look_at: Annotated[
-            str | None,
-            typer.Option(
-                help="Kinect: point 'X,Y,Z' the sensor aims at (default with --sensor-pos: "
-                "the performer)."
-            ),
-        ] = None,
-        sensor_height: Annotated[
-            float | None,
-            typer.Option(help="Kinect: height in metres of the automatic set-up (0.9)."),
-        ] = None,
+        fov: _device_option(str, "fisheye: field of view 'H,V' in degrees (150,120).") = None,
+        size: _device_option(
+            str,
+            f"fisheye: image size 'W,H' in pixels (640,480; {SIZE_RANGE[0]}-{SIZE_RANGE[1]} each).",
+        ) = None,
+        ring_offset: _device_option(
+            str,
+            "fisheye: ring camera 'X,Y,Z' in metres in the controller frame "
+            "(+X pointing, +Y left, +Z up; default 0.02,0,0.06).",
+        ) = None,
+        grip_offset: _device_option(
+            str, "fisheye: grip camera 'X,Y,Z' in metres (default -0.02,0,-0.06)."
+        ) = None,
+        ring_pitch: _device_option(
+            float, "fisheye: ring camera pitch in degrees above looking back (32.5)."
+        ) = None,
+        grip_pitch: _device_option(
+            float, "fisheye: grip camera pitch in degrees (-32.5: looking down)."
+        ) = None,
+        sensor_pos: _device_option(
+            str,
+            "Kinect: sensor position 'X,Y,Z' in metres (Z up). Default: set up in front of the "
+            "performer, the whole take in range where the sensor allows.",
+        ) = None,
+        sensor_yaw: _device_option(
+            float, "Kinect: heading of the optical axis in degrees (0 = +X, 90 = +Y)."
+        ) = None,
+        sensor_pitch: _device_option(
+            float, "Kinect: tilt of the optical axis in degrees (negative: down)."
+        ) = None,
+        sensor_look_at: _device_option(
+            str,
+            "Kinect: point 'X,Y,Z' the sensor aims at (default with --sensor-pos: the performer).",
+        ) = None,
+        sensor_height: _device_option(
+            float, "Kinect: height in metres of the automatic set-up (0.9)."
+        ) = None,
         unit: Annotated[str | None, typer.Option(help="File unit (see `info`).")] = None,
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
@@ -222,22 +290,20 @@ def register(app: typer.Typer) -> None:
 
         if device not in DEVICES:
             raise AvatarsimError(f"unknown device {device!r}; devices: {', '.join(DEVICES)}")
-        _check_device_options(
-            device,
-            {
-                "--fov": fov,
-                "--size": size,
-                "--ring-offset": ring_offset,
-                "--grip-offset": grip_offset,
-                "--ring-pitch": ring_pitch,
-                "--grip-pitch": grip_pitch,
-                "--sensor-pos": sensor_pos,
-                "--sensor-yaw": sensor_yaw,
-                "--sensor-pitch": sensor_pitch,
-                "--sensor-look-at": sensor_look_at,
-                "--sensor-height": sensor_height,
-            },
-        )
+        options = {
+            "--fov": fov,
+            "--size": size,
+            "--ring-offset": ring_offset,
+            "--grip-offset": grip_offset,
+            "--ring-pitch": ring_pitch,
+            "--grip-pitch": grip_pitch,
+            "--sensor-pos": sensor_pos,
+            "--sensor-yaw": sensor_yaw,
+            "--sensor-pitch": sensor_pitch,
+            "--sensor-look-at": sensor_look_at,
+            "--sensor-height": sensor_height,
+        }
+        _check_device_options(device, options)
         if duration_s is not None and end is not None:
             raise AvatarsimError("give --end or --duration-s, not both")
         if duration_s is not None and not 0 < duration_s <= MAX_DURATION_S:
@@ -249,47 +315,9 @@ def register(app: typer.Typer) -> None:
             raise AvatarsimError(f"--start to --end spans more than {MAX_DURATION_S:g} s")
         # Every device option is checked before the motion is loaded and retargeted.
         if device == "fisheye":
-            from render_cams.fisheye.model import FisheyeModel
-            from render_cams.fisheye.rig import Mount
-
-            fov_deg = _pair(fov, "--fov", (150, 120))
-            size_px = _pair(size, "--size", (640, 480), int)
-            if not all(0 < v < 180 for v in fov_deg):
-                raise AvatarsimError(
-                    f"--fov: a FOV must be two angles in (0, 180) degrees, got {fov!r}"
-                )
-            lo, hi = SIZE_RANGE
-            if not all(lo <= v <= hi for v in size_px):
-                raise AvatarsimError(f"--size must be two sides of {lo}-{hi} pixels, got {size!r}")
-            model = FisheyeModel.from_fov(*fov_deg, *size_px)
-            default = Mount()
-            mount = Mount(
-                ring_offset_m=_numbers(ring_offset, "--ring-offset", 3) or default.ring_offset_m,
-                grip_offset_m=_numbers(grip_offset, "--grip-offset", 3) or default.grip_offset_m,
-                ring_pitch_rad=default.ring_pitch_rad if ring_pitch is None else _rad(ring_pitch),
-                grip_pitch_rad=default.grip_pitch_rad if grip_pitch is None else _rad(grip_pitch),
-            )
+            _fisheye_rig(options)
         else:
-            from render_cams.kinect.placement import (
-                DEFAULT_HEIGHT_M,
-                KinectPlacementError,
-                look_at,
-                performer_target,
-                yaw_pitch_pose,
-            )
-
-            pos_xyz = _numbers(sensor_pos, "--sensor-pos", 3)
-            look_xyz = _numbers(sensor_look_at, "--sensor-look-at", 3)
-            height = DEFAULT_HEIGHT_M if sensor_height is None else sensor_height
-            if pos_xyz is not None and pos_xyz[2] < 0:
-                raise KinectPlacementError(f"--sensor-pos z = {pos_xyz[2]} m is below the floor")
-            if not (math.isfinite(height) and 0.0 <= height <= 3.0):
-                raise KinectPlacementError(f"--sensor-height must be in [0, 3] m, got {height}")
-            pose = None  # the automatic set-up, at --sensor-height
-            if sensor_yaw is not None or sensor_pitch is not None:
-                pose = yaw_pitch_pose(pos_xyz, _rad(sensor_yaw or 0.0), _rad(sensor_pitch or 0.0))
-            elif look_xyz is not None:
-                pose = look_at(pos_xyz, look_xyz)
+            _kinect_placement(options)
 
         check_outputs(json_out=json_out, out=out)
         # A built-in motion is generated long enough for the range asked.
@@ -305,28 +333,8 @@ def register(app: typer.Typer) -> None:
         from sim.humanoid import humanoid_for
 
         humanoid = humanoid_for(m)
-        body, m = humanoid.body, humanoid.motion
         t0 = time.perf_counter()
-        if device == "fisheye":
-            from render_cams.fisheye.sequence import render_fisheye_sequence
-
-            summary = render_fisheye_sequence(
-                m, out, seed=seed, model=model, body=body, mount=mount
-            )
-        else:
-            from render_cams.kinect.sequence import render_kinect_sequence
-
-            if pos_xyz is not None and pose is None:  # aimed at the performer
-                pose = look_at(pos_xyz, performer_target(m))
-            summary = render_kinect_sequence(
-                m,
-                out,
-                device=device,
-                seed=seed,
-                sensor_pose=pose,
-                body=body,
-                sensor_height_m=height,
-            )
+        summary = _record(device, options, humanoid, seed, out)
         elapsed = time.perf_counter() - t0
         summary = dict(summary)
         summary.setdefault("fps_rendered", summary.get("frames", 0) / max(elapsed, 1e-9))

@@ -11,7 +11,6 @@ import numpy as np
 
 from avatar_models.fileio import write_atomic
 from render_cams.kinect.depth import colourise, read_depth_png
-from render_cams.kinect.sensors import get_sensor
 from scripts.run_context import RunContext
 from scripts.scenario import Scenario
 
@@ -59,29 +58,29 @@ def run(ctx: RunContext) -> None:
     clip, body = window(ctx)
     panels = []
     if spec.fisheye:
-        from render_cams.fisheye.sequence import render_fisheye_sequence
+        from render_cams.fisheye.device import FisheyeRig
+        from render_cams.fisheye.sequence import write_fisheye_recording
 
         folder = ctx.out_dir / "cameras" / "fisheye"
-        summary = render_fisheye_sequence(
-            clip, folder, seed=ctx.scenario.seed, video=False, body=body
-        )
-        ctx.metrics["fisheye_fps_rendered"] = float(summary["fps_rendered"])
-        for name in summary["cameras"]:
-            panels.append(panel(iio.imread(folder / name / "000000.png"), name))
-        for stitched in summary.get("stitched", []):
+        recording = FisheyeRig().sample(clip, ctx.scenario.seed, body)
+        summary = write_fisheye_recording(recording, folder, video=False)
+        ctx.metrics["fisheye_fps_rendered"] = float(recording.fps_rendered)
+        for name, frames in zip(recording.names, recording.images, strict=True):
+            panels.append(panel(frames[0], name))
+        for stitched in summary["stitched"]:
             panels.append(panel(iio.imread(folder / stitched / "000000.png"), stitched))
         ctx.output("fisheye_keypoints", folder / "keypoints.json")
     if spec.kinect:
-        from render_cams.kinect.sequence import render_kinect_sequence
+        from render_cams.kinect.device import Kinect
+        from render_cams.kinect.sequence import write_kinect_recording
 
         folder = ctx.out_dir / "cameras" / spec.kinect
         t0 = time.perf_counter()
-        summary = render_kinect_sequence(
-            clip, folder, device=spec.kinect, seed=ctx.scenario.seed, body=body
-        )
-        ctx.metrics["kinect_fps_rendered"] = summary["frames"] / (time.perf_counter() - t0)
-        depth = read_depth_png(sorted((folder / "depth").glob("*.png"))[0])
-        bgr = colourise(depth, get_sensor(spec.kinect).range_m)
+        recording = Kinect(spec.kinect).sample(clip, ctx.scenario.seed, body)
+        write_kinect_recording(recording, folder)
+        ctx.metrics["kinect_fps_rendered"] = len(recording.frames) / (time.perf_counter() - t0)
+        first = read_depth_png(folder / "depth" / "000000.png")
+        bgr = colourise(first, recording.sensor.range_m)
         panels.append(panel(bgr[..., ::-1], f"{spec.kinect} depth"))
         ctx.output("kinect_recording", folder / "recording.json")
     if panels:

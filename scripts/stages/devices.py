@@ -30,7 +30,7 @@ def run(ctx: RunContext) -> None:
         return
     vr = setup(ctx)
     stream = vr.sample(ctx.motion, seed=ctx.scenario.seed)
-    ctx.artifacts["vr_stream"] = stream
+    ctx.vr_stream = stream
     ctx.metrics["vr_valid_frac"] = float(stream.valid.mean())
     ctx.info["devices"] = {
         "vr": list(stream.device_names),

@@ -54,12 +54,11 @@ def run(ctx: RunContext) -> None:
             "motion_gif", write_atomic(ctx.out_dir / "motion.gif", gif(frames, spec.gif_fps))
         )
 
-    synthesised: dict[str, Humanoid] = ctx.artifacts.get("synthesised", {})
-    if not synthesised:
+    if not ctx.synthesised:
         return
     # Ground truth and every method side by side at the same times (methods run at 90 Hz,
     # the truth at its own rate).
-    columns = {"ground truth": h} | synthesised
+    columns = {"ground truth": h} | ctx.synthesised
     span_s = min(c.motion.duration_s for c in columns.values())
     times_strip = np.linspace(0.0, min(span_s, spec.strip_span_s), 4)
     panels = [

@@ -74,7 +74,7 @@ def run(ctx: RunContext) -> None:
     spec = ctx.scenario.synthesis
     if spec is None:
         return
-    stream = ctx.artifacts["vr_stream"]
+    stream = ctx.vr_stream
     subject = ctx.motion.meta.get("subject")
     user_height_m = (subject.get("height_m") if isinstance(subject, dict) else None) or (
         standing_height(ctx.motion)
@@ -95,4 +95,4 @@ def run(ctx: RunContext) -> None:
             "hand_corr": corr,
             "err_cm": {g: ctx.metrics[f"{method}_err_cm_{g}"] for g in GROUPS},
         }
-    ctx.artifacts["synthesised"] = outputs
+    ctx.synthesised = outputs

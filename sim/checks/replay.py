@@ -158,8 +158,3 @@ class BodyReplay:
     def com(self) -> np.ndarray:
         """``(T, 3)`` whole-body centre of mass."""
         return self.trace.com(self.model)
-
-    @cached_property
-    def hinge_names(self) -> list[str]:
-        """Names of the hinges in qpos order (after the free root's 7 numbers)."""
-        return [self.model.joint(j).name for j in range(1, self.model.njnt)]

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.body import BodyDescription, BodyError, build_body
+from avatar_models.body import BodyDescription, BodyError, RestPoseNotUprightError, build_body
 from avatar_models.errors import AvatarsimError
 from avatar_models.rigs import load_rig
 from avatar_models.skeleton import Skeleton
@@ -132,7 +132,7 @@ def test_bad_inputs_raise_body_error():
 
 def test_a_rest_pose_that_does_not_stand_is_refused():
     # bandai.toml keeps the BVH's baked joint orientations: its rest pose is a crumpled heap.
-    with pytest.raises(BodyError, match="not upright"):
+    with pytest.raises(RestPoseNotUprightError, match="not upright"):
         build_body(load_rig("bandai").skeleton)
 
 

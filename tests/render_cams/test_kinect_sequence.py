@@ -8,16 +8,18 @@ import cv2
 import numpy as np
 
 from render_cams.kinect.depth import BODY_INDEX_NONE, read_depth_png
+from render_cams.kinect.device import Kinect
 from render_cams.kinect.placement import performer_distance
-from render_cams.kinect.sequence import render_kinect_sequence
+from render_cams.kinect.sequence import write_kinect_recording
 from tests.render_cams.builders import folder_bytes
 from tests.render_cams.kinect_builders import t_pose
 
 
 def test_sequence_writes_depth_body_index_skeleton_and_preview(tmp_path):
     motion = t_pose(4, fps=30.0)
-    record = render_kinect_sequence(motion, tmp_path / "a", "azure-kinect", seed=5, max_frames=3)
-    again = render_kinect_sequence(motion, tmp_path / "b", "azure-kinect", seed=5, max_frames=3)
+    kinect = Kinect("azure-kinect", max_frames=3)
+    record = write_kinect_recording(kinect.sample(motion, seed=5), tmp_path / "a")
+    again = write_kinect_recording(kinect.sample(motion, seed=5), tmp_path / "b")
     assert record["frames"] == 3 and record["seed"] == 5
     depth = read_depth_png(tmp_path / "a" / "depth" / "000002.png")
     assert depth.shape == (576, 640) and depth.dtype == np.uint16

@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import json
-
-import cv2
 import pytest
 
 from avatar_models.body import build_body
@@ -12,6 +9,7 @@ from avatar_models.body17 import INDEX
 from avatar_models.rigs import body17_positions, load_rig
 from render_cams.fisheye import occlusion
 from render_cams.fisheye.bad_frames import BLACK_LEVEL
+from render_cams.fisheye.device import FisheyeRig
 from render_cams.fisheye.model import FisheyeModel
 from render_cams.fisheye.render import FisheyeRenderer
 from render_cams.fisheye.rig import (
@@ -21,7 +19,6 @@ from render_cams.fisheye.rig import (
     controller_cameras,
     inside_body,
 )
-from render_cams.fisheye.sequence import render_fisheye_sequence
 from render_cams.kinect.placement import look_at
 from render_cams.scene import BodyScene, SceneError
 from tests.render_cams.kinect_builders import t_pose
@@ -39,20 +36,18 @@ def test_the_palm_mount_puts_the_ring_cameras_inside_the_hand():
     assert inside[:, [0, 2]].all() and not inside[:, [1, 3]].any()
 
 
-def test_camera_inside_the_body_records_a_dark_flagged_frame(tmp_path):
+def test_camera_inside_the_body_records_a_dark_flagged_frame():
     motion = t_pose(3)
-    summary = render_fisheye_sequence(
-        motion, tmp_path, model=TINY, mount=IN_THE_PALM, bad_frame_rate=0.0, video=False
-    )  # not refused
-    assert summary["frames"] == 3
-    assert summary["occluded_frames"] == {
+    rig = FisheyeRig(model=TINY, mount=IN_THE_PALM, bad_frame_rate=0.0)
+    recording = rig.sample(motion)  # not refused
+    assert recording.summary["frames"] == 3
+    assert recording.summary["occluded_frames"] == {
         "left_controller-ring": 3,
         "left_controller-grip": 0,
         "right_controller-ring": 3,
         "right_controller-grip": 0,
     }
-    records = json.loads((tmp_path / "keypoints.json").read_text())["records"]
-    for record in records:
+    for record in recording.records:
         ring = record["camera"].endswith("ring")
         assert record["occluded"] == ring
         if ring:
@@ -62,8 +57,7 @@ def test_camera_inside_the_body_records_a_dark_flagged_frame(tmp_path):
         else:
             assert record["lens_blocked"] < occlusion.OCCLUDED_FRACTION
             assert record["mean_luminance"] > 2 * BLACK_LEVEL
-    image = cv2.imread(str(tmp_path / "left_controller-ring" / "000001.png"))
-    range_mm = cv2.imread(str(tmp_path / "left_controller-ring" / "000001_range.png"), -1)
+    image, range_mm = recording.images[0, 1], recording.range_mm[0, 1]  # left ring, frame 1
     assert image.mean() < BLACK_LEVEL and not range_mm.any()  # nothing to measure
 
 
@@ -90,11 +84,11 @@ def test_lens_against_the_chest_is_blocked_and_dark():
     assert occlusion.mean_luminance(dark, circle) < occlusion.mean_luminance(colour, circle)
 
 
-def test_bad_mounts_and_mismatched_bodies_are_typed_errors(tmp_path):
+def test_bad_mounts_and_mismatched_bodies_are_typed_errors():
     with pytest.raises(CameraMountError, match="within"):
         Mount(ring_offset_m=(0.5, 0.0, 0.0))
     with pytest.raises(CameraMountError, match="pitch"):
         Mount(grip_pitch_rad=2.0)
     cmu_body = build_body(load_rig("cmu").skeleton)  # not the t-pose motion's rig
     with pytest.raises(SceneError, match="retarget"):
-        render_fisheye_sequence(t_pose(2), tmp_path, model=TINY, body=cmu_body, video=False)
+        FisheyeRig(model=TINY).sample(t_pose(2), body=cmu_body)

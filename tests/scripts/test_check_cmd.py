@@ -75,3 +75,15 @@ def test_unknown_rig_exits_2(tmp_path):
     )
     result = runner.invoke(app, ["check", str(bvh), "--out", str(tmp_path / "o")])
     assert result.exit_code == 2 and "rig" in result.stderr
+
+
+def test_corrupt_makes_the_check_for_that_defect_fail(tmp_path):
+    path = save_motion(generate("walk", duration_s=2.0, seed=1), tmp_path / "w.npz")
+    js = tmp_path / "c.json"
+    args = ["check", str(path), "--out", str(tmp_path / "o"), "--json", str(js)]
+    result = runner.invoke(app, [*args, "--corrupt", "floating"])
+    assert result.exit_code == 1
+    floating = [c for c in json.loads(js.read_text())["checks"] if c["check"] == "floating"]
+    assert floating and not all(c["passed"] for c in floating)
+    result = runner.invoke(app, [*args, "--corrupt", "melting"])
+    assert result.exit_code == 2 and "defects are" in result.stderr

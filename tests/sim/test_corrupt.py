@@ -106,3 +106,14 @@ def test_an_anatomically_impossible_knee_is_flagged(flexion_deg):
     knee = body.skeleton.names[body.anatomy.body17["l_knee"]]
     violations = report.contract()["details"]["joint_limits"]["violations"]
     assert any(name.startswith(knee) for name in violations), violations
+
+
+def test_corrupt_names_each_defect_by_its_check():
+    motion = generate("walk", duration_s=0.5, seed=1)
+    body = build_body(motion.skeleton)
+    stance = np.zeros(motion.n_frames, bool)
+    raised = corrupt.corrupt("floating", motion, body, stance, np.random.default_rng(0))
+    np.testing.assert_allclose(raised.root_pos[:, 2] - motion.root_pos[:, 2], 0.15)
+    assert set(corrupt.DEFECTS) == set(DEFECTS)
+    with pytest.raises(ValueError, match="defects"):
+        corrupt.corrupt("melting", motion, body, stance, np.random.default_rng(0))

@@ -1,0 +1,219 @@
+"""``FisheyeRig``: the fisheye cameras on the VR controllers (ControllerPose §4) as one ``Device``.
+
+``FisheyeRig(...).sample(motion, seed, body) -> FisheyeRecording`` renders every controller
+camera over ``motion`` at the sensor's 30 Hz (ControllerPose §4.1), in memory: colour frames
+with bad frames injected (§4.2, about 1 in 50) when ``bad_frame_rate > 0``, the range along
+each pixel's ray, and one self-describing record per camera frame
+(:mod:`render_cams.fisheye.records`), incl. the bad-frame ground truth and the occlusion flags
+(a camera inside or against the body records a dark frame, :mod:`render_cams.fisheye.occlusion`).
+:func:`render_cams.fisheye.sequence.write_fisheye_recording` writes a recording to a folder.
+
+Everything random comes from one seed, split with ``numpy.random.SeedSequence`` into bad-frame
+injection, detector noise and dark frames.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from avatar_models import Motion
+from avatar_models.body import BodyDescription
+from avatar_models.rigs import body17_positions
+from render_cams.device import DeviceError, check_rate, motion_at_rate, resolve_seed
+from render_cams.fisheye import bad_frames, occlusion
+from render_cams.fisheye.keypoints import (
+    DetectorNoise,
+    confidence,
+    joint_thickness,
+    project_joints,
+    visibility,
+    world_to_camera,
+)
+from render_cams.fisheye.model import FisheyeModel
+from render_cams.fisheye.records import frame_record
+from render_cams.fisheye.render import FisheyeRenderer
+from render_cams.fisheye.rig import (
+    ControllerCamera,
+    Mount,
+    camera_poses,
+    controller_cameras,
+    inside_body,
+)
+from render_cams.scene import BodyScene, body_for_motion
+
+CAMERA_RATE_HZ = 30.0
+SCALE_RANGE = (0.05, 4.0)  # image size factors for quick looks (0.125: 80x60)
+
+
+@dataclass(frozen=True, eq=False)
+class FisheyeRecording:
+    """What the controller cameras recorded: ``C`` cameras, ``T`` frames of ``H x W``.
+
+    Attributes:
+        cameras: ``(C,)`` the cameras, in rig order.
+        names: ``(C,)`` their folder-safe names (e.g. ``left_controller-ring``).
+        model: the camera model of every camera.
+        images: ``(C, T, H, W, 3)`` uint8 RGB as recorded (bad frames injected, dark when
+            occluded).
+        range_mm: ``(C, T, H, W)`` uint16 range along each pixel's ray in millimetres (0: none).
+        records: ``C * T`` frame records (:func:`~render_cams.fisheye.records.frame_record`),
+            frame by frame, cameras in rig order within a frame.
+        summary: ``{"frames", "cameras", "fps", "bad_frames", "occluded_frames", "seed",
+            "model"}``; like ``records``, it depends on the motion and seed alone.
+        fps_rendered: camera frames rendered per second of wall time (not part of the data).
+    """
+
+    cameras: tuple[ControllerCamera, ...]
+    names: tuple[str, ...]
+    model: FisheyeModel
+    images: np.ndarray
+    range_mm: np.ndarray
+    records: list[dict[str, Any]]
+    summary: dict[str, Any]
+    fps_rendered: float
+
+
+@dataclass(frozen=True, eq=False)
+class FisheyeRig:
+    """The controller cameras and how they record.
+
+    Attributes:
+        model: camera model (default :meth:`FisheyeModel.from_fov`: 150 x 120 degrees,
+            640 x 480); after construction, the model as scaled by ``scale``.
+        scale: image size factor in :data:`SCALE_RANGE`, for quick looks.
+        rate_hz: frame rate of every camera.
+        bad_frame_rate: share of frames corrupted (interference, sync loss).
+        detector_noise: noise on the 2D keypoints of the records (None: exact).
+        controllers: controllers that carry cameras (two each, ring and grip).
+        mount: where the cameras sit on a controller (default :class:`Mount`).
+    """
+
+    model: FisheyeModel | None = None
+    scale: float = 1.0
+    rate_hz: float = CAMERA_RATE_HZ
+    bad_frame_rate: float = bad_frames.BAD_FRAME_RATE
+    detector_noise: DetectorNoise | None = None
+    controllers: Sequence[str] = ("left_controller", "right_controller")
+    mount: Mount | None = None
+    name: str = "fisheye"
+
+    def __post_init__(self) -> None:
+        lo, hi = SCALE_RANGE
+        if not (np.isfinite(self.scale) and lo <= self.scale <= hi):
+            raise DeviceError(f"scale must be in [{lo:g}, {hi:g}], got {self.scale}")
+        model = self.model or FisheyeModel.from_fov()
+        object.__setattr__(self, "model", model.scaled(self.scale) if self.scale != 1.0 else model)
+        object.__setattr__(self, "rate_hz", check_rate(self.rate_hz))
+        object.__setattr__(self, "controllers", tuple(self.controllers))
+
+    def sample(
+        self,
+        motion: Motion,
+        seed: int | np.random.Generator = 0,
+        body: BodyDescription | None = None,
+    ) -> FisheyeRecording:
+        """Every controller camera over ``motion``.
+
+        Args:
+            body: the humanoid to render (built once by the caller for this motion);
+                ``motion`` must be on its skeleton. Default: a body built from ``motion``'s
+                skeleton.
+
+        Raises:
+            RigError: a skeleton without a body17 map; SceneError: ``motion`` not on
+            ``body``'s skeleton.
+        """
+        seed = resolve_seed(seed)
+        model = self.model
+        sampled = motion_at_rate(motion, self.rate_hz)
+        body = body_for_motion(sampled, body)
+        cameras = controller_cameras(self.controllers, self.mount)
+        poses = camera_poses(sampled, cameras)  # (T, C, 4, 4)
+        inside = inside_body(body, *sampled.fk(), poses[..., :3, 3])  # (T, C): lens covered
+        joints = body17_positions(sampled)  # (T, 17, 3)
+        thickness = joint_thickness(body)
+        # The third stream (dark frames) leaves the first two as they were with two.
+        rng_inject, rng_noise, rng_dark = (
+            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)
+        )
+
+        names = tuple(c.name.replace("/", "-") for c in cameras)
+        n_frames, n_cams = poses.shape[:2]
+        images = np.zeros((n_cams, n_frames, model.height, model.width, 3), np.uint8)
+        range_mm = np.zeros((n_cams, n_frames, model.height, model.width), np.uint16)
+        blocked = np.zeros((n_cams, n_frames))
+        seen: list[tuple] = []
+        start = time.perf_counter()
+        with BodyScene(body) as scene:
+            renderer = FisheyeRenderer(scene, model)
+            circle = renderer.maps.range_scale > 0
+            for t in range(n_frames):  # rendering is inherently per frame
+                scene.update(sampled, t)
+                for c in range(n_cams):
+                    if inside[t, c]:
+                        color = occlusion.dark_frame(model.height, model.width, rng_dark)
+                        range_m = np.zeros((model.height, model.width), np.float32)
+                        blocked[c, t] = 1.0
+                    else:
+                        color, range_m = renderer.render(poses[t, c])
+                        color, blocked[c, t] = occlusion.block_lens(color, range_m, circle)
+                    images[c, t] = color
+                    range_mm[c, t] = np.clip(np.rint(range_m * 1000.0), 0, 65535)
+                    uv, in_image, joint_range = project_joints(
+                        model, poses[t, c][None], joints[t][None]
+                    )
+                    vis = visibility(uv[0], in_image[0], joint_range[0], range_m, thickness)
+                    seen.append((t, c, uv[0], in_image[0], vis & ~inside[t, c]))
+        elapsed = time.perf_counter() - start
+
+        truth = np.zeros((n_cams, n_frames), bool)
+        for c in range(n_cams):
+            images[c], truth[c], _ = bad_frames.inject(images[c], rng_inject, self.bad_frame_rate)
+        occluded = blocked >= occlusion.OCCLUDED_FRACTION  # (C, T)
+        w2c = world_to_camera(poses)
+        records = []
+        for t, c, uv, in_image, vis in seen:
+            conf = confidence(model, uv, vis)
+            if self.detector_noise is not None:
+                uv, detected, conf = self.detector_noise.apply(uv, vis, conf, rng_noise)
+                in_image = in_image & detected
+            records.append(
+                frame_record(
+                    names[c],
+                    model,
+                    t,
+                    t / self.rate_hz,
+                    w2c[t, c],
+                    joints[t],
+                    uv,
+                    in_image,
+                    vis,
+                    conf,
+                    bad_frame=bool(truth[c, t]),
+                    lens_blocked=blocked[c, t],
+                    occluded=bool(occluded[c, t]),
+                    mean_luminance=occlusion.mean_luminance(images[c, t], circle),
+                )
+            )
+        flagged = np.stack([bad_frames.detect(images[c]) for c in range(n_cams)])
+        # Occluded frames are dark for a reason the injected faults do not cover: the detector
+        # is scored on the other frames only.
+        clear = ~occluded
+        summary = {
+            "frames": int(n_frames),
+            "cameras": list(names),
+            "fps": self.rate_hz,
+            "bad_frames": bad_frames.precision_recall(truth[clear], flagged[clear]),
+            "occluded_frames": {name: int(occluded[c].sum()) for c, name in enumerate(names)},
+            "seed": seed,
+            "model": model.as_dict(),
+        }
+        fps_rendered = n_frames * n_cams / max(elapsed, 1e-9)
+        return FisheyeRecording(
+            tuple(cameras), names, model, images, range_mm, records, summary, fps_rendered
+        )
