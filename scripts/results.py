@@ -25,13 +25,25 @@ from scripts.scenario import Threshold
 
 @dataclass(frozen=True)
 class CheckResult:
+    """A value against its threshold. ``expected_fail`` (the scenario's ``expect_fail``) turns
+    the verdict round: the check passes when the threshold is NOT met (a detector proven)."""
+
     name: str
     value: float
     threshold: Threshold
+    expected_fail: bool = False
 
     @property
     def passed(self) -> bool:
-        return self.threshold.passes(self.value)
+        return self.threshold.passes(self.value) != self.expected_fail
+
+    def failure_message(self) -> str:
+        """Why a check that did not pass failed (empty when it passed)."""
+        if self.passed:
+            return ""
+        if self.expected_fail:
+            return f"{self.value:.4g} is {self.threshold.describe()}, but expected to fail"
+        return f"{self.value:.4g} not {self.threshold.describe()}"
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -41,6 +53,7 @@ class CheckResult:
             if self.threshold.min is None
             else self.threshold.describe(),
             "passed": self.passed,
+            **({"expected_fail": True} if self.expected_fail else {}),
         }
 
 
@@ -264,9 +277,7 @@ def junit_xml(suite: str, checks: list[CheckResult], time_s: float = 0.0) -> str
     for c in checks:
         case = ET.SubElement(root, "testcase", classname=f"avatarsim.{suite}", name=c.name)
         if not c.passed:
-            failure = ET.SubElement(
-                case, "failure", message=f"{c.value:.4g} not {c.threshold.describe()}"
-            )
+            failure = ET.SubElement(case, "failure", message=c.failure_message())
             failure.text = f"{c.name} = {c.value!r}, threshold {c.threshold.describe()}"
     ET.indent(root)
     return ET.tostring(root, encoding="unicode", xml_declaration=True) + "\n"
