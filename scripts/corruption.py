@@ -33,10 +33,3 @@ def corrupted(motion: Motion, defect: str, seed: int) -> Motion:
     stance = check_motion(motion, body).per_frame()["contact_left"] > 0
     return corrupt.inject_sliding(motion, stance)
 
-
-def with_output_noise(motion: Motion, sigma_m: float, seed: int) -> Motion:
-    """``motion`` with white noise of ``sigma_m`` per axis on its root position: a
-    deliberately worse method, for regression suites (``synthesis.output_noise_m``)."""
-    if sigma_m == 0:
-        return motion
-    return corrupt.add_jitter(motion, np.random.default_rng(seed), sigma_m)

@@ -44,7 +44,6 @@ VR_NOISE = ("none", "realistic")
 # sim.corrupt's defects a scenario's motion can be given (``motion.corrupt``), each one that a
 # physics check must flag (scripts/corruption.py applies them).
 CORRUPTIONS = ("sink_feet", "float_body", "bend_knee", "inject_sliding", "add_jitter")
-MAX_OUTPUT_NOISE_M = 1.0
 
 # Bounds of a scenario's numbers (and the CLI's): beyond them a run is a typo that would
 # compute for hours or measure nothing.
@@ -109,7 +108,6 @@ class SynthesisSpec:
     database_duration_s: float = 8.0
     foot_contact: bool = True  # CoolMoves' stance-foot clean-up (beyond the paper)
     arm_ik: float = 1.0  # CoolMoves' arm correction toward the controllers (0 = the paper's)
-    output_noise_m: float = 0.0  # white noise on every method's output root (a worse method)
 
 
 @dataclass(frozen=True)
@@ -253,8 +251,6 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
         )
     if synthesis and not 0 <= synthesis.arm_ik <= 1:
         raise ScenarioError(f"synthesis.arm_ik must be 0-1, got {synthesis.arm_ik}")
-    if synthesis and not 0 <= synthesis.output_noise_m <= MAX_OUTPUT_NOISE_M:
-        raise ScenarioError(f"synthesis.output_noise_m must be 0-{MAX_OUTPUT_NOISE_M:g} (metres)")
     if motion.corrupt is not None and motion.corrupt not in CORRUPTIONS:
         raise ScenarioError(f"motion.corrupt must be one of {CORRUPTIONS}, got {motion.corrupt!r}")
     if not 0 < motion.duration_s <= MAX_MOTION_S:

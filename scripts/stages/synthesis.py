@@ -8,7 +8,6 @@ import numpy as np
 from avatar_models.generator import generate_library
 from avatar_models.measure import standing_height
 from avatar_models.motion import Motion
-from scripts.corruption import with_output_noise
 from scripts.run_context import RunContext
 from scripts.scenario import Scenario, ScenarioError
 from sim.humanoid import Humanoid, humanoid_for
@@ -83,7 +82,6 @@ def run(ctx: RunContext) -> None:
     outputs: dict[str, Humanoid] = {}
     for method in spec.methods:
         output = make_synthesizer(method, ctx, user_height_m).run(stream)
-        output = with_output_noise(output, spec.output_noise_m, ctx.scenario.seed)
         outputs[method] = humanoid = humanoid_for(output)
         for group, value in body17_errors_cm(output, ctx.motion).items():
             ctx.metrics[f"{method}_err_cm_{group}"] = value
