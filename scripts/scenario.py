@@ -55,6 +55,8 @@ GIF_FPS_RANGE = (1.0, 60.0)  # frame rates a GIF viewer plays
 MAX_STRIP_SPAN_S = 60.0
 MAX_DATABASE_SUBJECTS = 50
 MASS_RANGE_KG = (10.0, 300.0)
+# devices.* sweep bounds: beyond them no tracking is left to synthesise from.
+DEVICE_SWEEP_MAX = {"latency_s": 1.0, "jitter_m": 0.5, "dropouts_per_s": 10.0}
 
 
 class ScenarioError(AvatarsimError):
@@ -91,11 +93,16 @@ class ReportSpec:
 @dataclass(frozen=True)
 class DevicesSpec:
     """Simulated VR tracking (``render_cams.vr``); ``noise`` is ``"none"`` or ``"realistic"``
-    (Lighthouse-grade jitter, latency, slow drift)."""
+    (Lighthouse-grade jitter, latency, slow drift). For sweeps, ``latency_s``, ``jitter_m``
+    (position, per axis) and ``dropouts_per_s`` (0.5 s bursts of tracking loss) add one
+    more model each, after the preset."""
 
     vr: bool = True
     trackers: bool = False
     noise: str = "realistic"
+    latency_s: float = 0.0
+    jitter_m: float = 0.0
+    dropouts_per_s: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -237,6 +244,10 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
         raise ScenarioError(f"tracking.seconds must be above 0 and at most {MAX_TRACK_S:g}")
     if optional["devices"] and optional["devices"].noise not in VR_NOISE:
         raise ScenarioError(f"devices.noise must be one of {VR_NOISE}")
+    for key, most in DEVICE_SWEEP_MAX.items():
+        value = getattr(optional["devices"], key, 0.0)
+        if not 0 <= value <= most:
+            raise ScenarioError(f"devices.{key} must be 0-{most:g}, got {value}")
     if optional["synthesis"] and not optional["devices"]:
         raise ScenarioError("[synthesis] needs a [devices] table (the VR stream it runs on)")
     synthesis = optional["synthesis"]
