@@ -32,4 +32,3 @@ def corrupted(motion: Motion, defect: str, seed: int) -> Motion:
     # inject_sliding: the left foot slides during its stances, found on the clean motion.
     stance = check_motion(motion, body).per_frame()["contact_left"] > 0
     return corrupt.inject_sliding(motion, stance)
-
