@@ -160,7 +160,7 @@ def run(
     One scenario file writes its outputs into --out. Several, a folder, -k or a baseline make
     a suite: a folder per scenario plus junit.xml, results.json and index.html for them all.
     """
-    from scripts.suite.command import SuiteOptions, check_options, run_paths
+    from scripts.suite.command import SuiteOptions, check_options, print_summary, run_paths
     from scripts.suite.regression import baseline_file
 
     options = SuiteOptions(workers, fail_fast, select, baseline, update_baseline, seed)
@@ -176,23 +176,10 @@ def run(
         _run(sc, out, json_out)
         return
     results = run_paths(scenarios, out, options, err_console)
-    _show_suite(results, out)
+    print_summary(results, out, console)
     emit_json(json_out, results)
     if not results["passed"]:
         raise typer.Exit(1)
-
-
-def _show_suite(results: dict[str, Any], out: Path) -> None:
-    table = Table(title="suite")
-    for col in ("scenario", "status", "checks failed", "regressions"):
-        table.add_column(col)
-    for sc in results["scenarios"]:
-        failed = sum(not c["passed"] for c in sc["checks"])
-        worse = sum(r["regressed"] for r in sc["regression"])
-        colour = {"passed": "green", "failed": "red", "error": "red"}.get(sc["status"], "dim")
-        table.add_row(escape(sc["name"]), f"[{colour}]{sc['status']}[/]", str(failed), str(worse))
-    console.print(table)
-    console.print(f"suite results in {escape(str(out))}/ (junit.xml, results.json, index.html)")
 
 
 @app.command()

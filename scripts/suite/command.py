@@ -14,6 +14,7 @@ from typing import Any
 
 from rich.console import Console
 from rich.markup import escape
+from rich.table import Table
 
 from avatar_models.errors import AvatarsimError
 from scripts.results import atomic_dir, versions, write_atomic, write_json
@@ -28,9 +29,10 @@ from scripts.suite.regression import (
     compare,
     load_baseline,
 )
-from scripts.suite.runner import Outcome, run_suite
+from scripts.suite.runner import STATUSES, Outcome, run_suite
 
 MAX_WORKERS = 256
+COLOURS = {"passed": "green", "failed": "red", "error": "red", "skipped": "dim"}
 
 
 @dataclass(frozen=True)
@@ -97,8 +99,7 @@ def scenario_record(outcome: Outcome, baseline: dict[str, BaselineEntry]) -> dic
 
 
 def suite_results(records: list[dict[str, Any]], baseline: Path | None) -> dict[str, Any]:
-    counts = {s: sum(r["status"] == s for r in records) for s in ("passed", "failed")}
-    counts |= {s: sum(r["status"] == s for r in records) for s in ("skipped", "error")}
+    counts = {status: sum(r["status"] == status for r in records) for status in STATUSES}
     counts["regressions"] = sum(row["regressed"] for r in records for row in r["regression"])
     counts["improvements"] = sum(row["improved"] for r in records for row in r["regression"])
     return {
@@ -124,8 +125,7 @@ def run_paths(
     console.print(f"suite: {len(entries)} scenario(s), {options.workers} worker(s)")
 
     def show(outcome: Outcome) -> None:
-        colour = {"passed": "green", "failed": "red", "error": "red"}.get(outcome.status, "")
-        mark = f"[{colour}]{outcome.status}[/]" if colour else outcome.status
+        mark = f"[{COLOURS[outcome.status]}]{outcome.status}[/]"
         console.print(f"  {escape(outcome.name)}: {mark} ({outcome.time_s:.1f} s)")
 
     with atomic_dir(out, "run") as partial:
@@ -141,3 +141,17 @@ def run_paths(
         write_json(file, results)
         console.print(f"baseline written to {escape(str(file))}")
     return results
+
+
+def print_summary(results: dict[str, Any], out: Path, console: Console) -> None:
+    """A table of the suite's scenarios: status, failed checks, regressions."""
+    table = Table(title="suite")
+    for col in ("scenario", "status", "checks failed", "regressions"):
+        table.add_column(col)
+    for sc in results["scenarios"]:
+        failed = sum(not c["passed"] for c in sc["checks"])
+        worse = sum(r["regressed"] for r in sc["regression"])
+        status = f"[{COLOURS[sc['status']]}]{sc['status']}[/]"
+        table.add_row(escape(sc["name"]), status, str(failed), str(worse))
+    console.print(table)
+    console.print(f"suite results in {escape(str(out))}/ (junit.xml, results.json, index.html)")
