@@ -131,21 +131,55 @@ def _run(scenario_obj: Any, out: Path, json_out: Path | None) -> None:
 @app.command()
 @user_errors
 def run(
-    scenario: Annotated[Path, typer.Argument(help="Scenario TOML file.")],
+    scenarios: Annotated[
+        list[Path],
+        typer.Argument(
+            help="Scenario TOML files and folders (searched for *.toml).", show_default=False
+        ),
+    ],
     out: Annotated[Path, typer.Option(help="Output folder.")] = Path("out/run"),
     seed: Annotated[
-        int | None, typer.Option("--seed", help="Override the scenario's seed.")
+        int | None, typer.Option("--seed", help="Override every scenario's seed.")
     ] = None,
+    workers: Annotated[int, typer.Option(help="Scenarios run in parallel processes.")] = 1,
+    fail_fast: Annotated[bool, typer.Option(help="Stop at the first failure.")] = False,
+    select: Annotated[
+        str | None, typer.Option("-k", help="Only scenarios whose name contains or matches this.")
+    ] = None,
+    baseline: Annotated[
+        Path | None,
+        typer.Option(help="Compare metrics with this suite folder or results.json."),
+    ] = None,
+    update_baseline: Annotated[
+        bool, typer.Option(help="Write this run's results as the new --baseline.")
+    ] = False,
     json_out: JsonOpt = None,
 ) -> None:
-    """Run a scenario: source -> devices -> methods -> checks. Exit 1 if a threshold fails."""
-    from scripts.scenario import load_scenario
+    """Run scenarios: source -> devices -> methods -> checks. Exit 1 if a threshold fails.
 
-    check_outputs(json_out=json_out, out=out, out_owner="run")
-    sc = load_scenario(scenario)
-    if seed is not None:
-        sc = dataclasses.replace(sc, seed=seed)
-    _run(sc, out, json_out)
+    One scenario file writes its outputs into --out. Several, a folder, -k or a baseline make
+    a suite: a folder per scenario plus junit.xml, results.json and index.html for them all.
+    """
+    from scripts.suite.command import SuiteOptions, check_options, print_summary, run_paths
+    from scripts.suite.regression import baseline_file
+
+    options = SuiteOptions(workers, fail_fast, select, baseline, update_baseline, seed)
+    check_options(options)
+    files = {"--baseline": baseline_file(baseline) if update_baseline else None}
+    check_outputs(json_out=json_out, out=out, out_owner="run", files=files)
+    if len(scenarios) == 1 and scenarios[0].is_file() and not (select or baseline):
+        from scripts.scenario import load_scenario
+
+        sc = load_scenario(scenarios[0])
+        if seed is not None:
+            sc = dataclasses.replace(sc, seed=seed)
+        _run(sc, out, json_out)
+        return
+    results = run_paths(scenarios, out, options, err_console)
+    print_summary(results, out, console)
+    emit_json(json_out, results)
+    if not results["passed"]:
+        raise typer.Exit(1)
 
 
 @app.command()

@@ -7,6 +7,7 @@ runs, and nothing is written for a scenario that does not validate.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from pathlib import Path
 from typing import Any
@@ -20,6 +21,7 @@ from scripts.results import ThresholdResult, atomic_dir, junit_xml, versions
 from scripts.run_context import RunContext
 from scripts.scenario import Scenario, ScenarioError
 from scripts.stages import STAGES, physics
+from scripts.suite.identity import scenario_hash
 from sim.thresholds import ConfigError
 
 METRICS: dict[str, str] = {k: v for stage in STAGES for k, v in stage.METRICS.items()}
@@ -47,6 +49,13 @@ def validate(scenario: Scenario) -> None:
         raise ScenarioError(
             f"thresholds name metric(s) {idle} that this scenario does not produce "
             "(enable the stage or method that measures them)"
+        )
+    checked = set(scenario.thresholds) | set(physics.METRICS)
+    unchecked = sorted(set(scenario.expect_fail) - checked)
+    if unchecked:
+        raise ScenarioError(
+            f"expect_fail names {unchecked}, which are not checks of this scenario; checks: "
+            f"its [thresholds] and the physics checks {sorted(physics.METRICS)}"
         )
     try:
         physics.config(scenario.physics)
@@ -76,8 +85,10 @@ def _run_stages(scenario: Scenario, out_dir: Path, console: Console) -> dict[str
         timings[name] = round(time.perf_counter() - t0, 3)
         console.log(f"{name} done in {timings[name]:.2f} s")
     checks = [
-        ThresholdResult(k, ctx.metrics[k], t) for k, t in scenario.thresholds.items()
-    ] + ctx.checks
+        dataclasses.replace(c, expected_fail=c.name in scenario.expect_fail)
+        for c in [ThresholdResult(k, ctx.metrics[k], t) for k, t in scenario.thresholds.items()]
+        + ctx.checks
+    ]
     passed = all(c.passed for c in checks)
     results = {
         "scenario": scenario.name,
@@ -86,6 +97,7 @@ def _run_stages(scenario: Scenario, out_dir: Path, console: Console) -> dict[str
         "checks": [c.to_json() for c in checks],
         "metrics": ctx.metrics,
         "seeds": {"scenario": scenario.seed},
+        "scenario_hash": scenario_hash(scenario),
         **ctx.info,
         "outputs": {
             **ctx.outputs,

@@ -24,15 +24,25 @@ from scripts.scenario import Threshold
 class ThresholdResult:
     """One scenario threshold applied to one run metric (a row of ``checks`` in
     ``results.json`` and a JUnit testcase); not a physics check's finding
-    (:class:`sim.checks.CheckResult`)."""
+    (:class:`sim.checks.CheckResult`). ``expected_fail`` (the scenario's ``expect_fail``)
+    turns the verdict round: it passes when the threshold is NOT met (a detector proven)."""
 
     name: str
     value: float
     threshold: Threshold
+    expected_fail: bool = False
 
     @property
     def passed(self) -> bool:
-        return self.threshold.passes(self.value)
+        return self.threshold.passes(self.value) != self.expected_fail
+
+    def failure_message(self) -> str:
+        """Why a check that did not pass failed (empty when it passed)."""
+        if self.passed:
+            return ""
+        if self.expected_fail:
+            return f"{self.value:.4g} is {self.threshold.describe()}, but expected to fail"
+        return f"{self.value:.4g} not {self.threshold.describe()}"
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -42,6 +52,7 @@ class ThresholdResult:
             if self.threshold.min is None
             else self.threshold.describe(),
             "passed": self.passed,
+            **({"expected_fail": True} if self.expected_fail else {}),
         }
 
 
@@ -236,9 +247,7 @@ def junit_xml(suite: str, checks: list[ThresholdResult], time_s: float = 0.0) ->
     for c in checks:
         case = ET.SubElement(root, "testcase", classname=f"avatarsim.{suite}", name=c.name)
         if not c.passed:
-            failure = ET.SubElement(
-                case, "failure", message=f"{c.value:.4g} not {c.threshold.describe()}"
-            )
+            failure = ET.SubElement(case, "failure", message=c.failure_message())
             failure.text = f"{c.name} = {c.value!r}, threshold {c.threshold.describe()}"
     ET.indent(root)
     return ET.tostring(root, encoding="unicode", xml_declaration=True) + "\n"

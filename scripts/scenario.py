@@ -20,6 +20,9 @@ A scenario names a motion source, the body, the stages to run and pass/fail thre
     [tracking]                # physics tracking of the ground truth (optional)
     seconds = 3.0
     search = true             # false: the plain controller (fast, lasts a few steps)
+    expect_fail = ["penetration_cm_p95"]  # checks that must fail (a suite proving a detector)
+    [regression]              # metric = tolerance against --baseline (defaults by metric kind)
+    coolmoves_err_cm_full = 0.5
 
 Unknown keys, wrong types and impossible values raise :class:`ScenarioError` naming the key.
 """
@@ -38,6 +41,9 @@ from avatar_models.errors import AvatarsimError
 from avatar_models.motion import FPS_RANGE
 
 VR_NOISE = ("none", "realistic")
+# sim.corrupt's defects a scenario's motion can be given (``motion.corrupt``), each one that a
+# physics check must flag (scripts/corruption.py applies them).
+CORRUPTIONS = ("sink_feet", "float_body", "bend_knee", "inject_sliding", "add_jitter")
 
 # Bounds of a scenario's numbers (and the CLI's): beyond them a run is a typo that would
 # compute for hours or measure nothing.
@@ -49,6 +55,8 @@ GIF_FPS_RANGE = (1.0, 60.0)  # frame rates a GIF viewer plays
 MAX_STRIP_SPAN_S = 60.0
 MAX_DATABASE_SUBJECTS = 50
 MASS_RANGE_KG = (10.0, 300.0)
+# devices.* sweep bounds: beyond them no tracking is left to synthesise from.
+DEVICE_SWEEP_MAX = {"latency_s": 1.0, "jitter_m": 0.5, "dropouts_per_s": 10.0}
 
 
 class ScenarioError(AvatarsimError):
@@ -64,6 +72,8 @@ class MotionSpec:
     height_m: float | None = None
     style: str | None = None
     unit: str | None = None
+    corrupt: str | None = None  # one of CORRUPTIONS: the ground truth made physically wrong
+    skip_if_absent: bool = False  # a missing motion file skips the scenario (real mocap)
 
 
 @dataclass(frozen=True)
@@ -83,11 +93,16 @@ class ReportSpec:
 @dataclass(frozen=True)
 class DevicesSpec:
     """Simulated VR tracking (``render_cams.vr``); ``noise`` is ``"none"`` or ``"realistic"``
-    (Lighthouse-grade jitter, latency, slow drift)."""
+    (Lighthouse-grade jitter, latency, slow drift). For sweeps, ``latency_s``, ``jitter_m``
+    (position, per axis) and ``dropouts_per_s`` (0.5 s bursts of tracking loss) add one
+    more model each, after the preset."""
 
     vr: bool = True
     trackers: bool = False
     noise: str = "realistic"
+    latency_s: float = 0.0
+    jitter_m: float = 0.0
+    dropouts_per_s: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -151,6 +166,8 @@ class Scenario:
     tracking: TrackingSpec | None = None
     thresholds: dict[str, Threshold] = field(default_factory=dict)
     physics: dict[str, float] = field(default_factory=dict)
+    expect_fail: tuple[str, ...] = ()
+    regression: dict[str, float] = field(default_factory=dict)
     path: str | None = None
 
 
@@ -207,7 +224,7 @@ def _threshold(name: str, raw: Any) -> Threshold:
 def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
     """Validate a parsed TOML table into a :class:`Scenario`."""
     top = {"name", "seed", "motion", "body", "report", "devices", "synthesis", "cameras"}
-    top |= {"tracking", "thresholds", "physics"}
+    top |= {"tracking", "thresholds", "physics", "expect_fail", "regression"}
     unknown = sorted(set(data) - top)
     if unknown:
         raise ScenarioError(f"unknown top-level key(s) {unknown}; allowed: {sorted(top)}")
@@ -227,6 +244,10 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
         raise ScenarioError(f"tracking.seconds must be above 0 and at most {MAX_TRACK_S:g}")
     if optional["devices"] and optional["devices"].noise not in VR_NOISE:
         raise ScenarioError(f"devices.noise must be one of {VR_NOISE}")
+    for key, most in DEVICE_SWEEP_MAX.items():
+        value = getattr(optional["devices"], key, 0.0)
+        if not 0 <= value <= most:
+            raise ScenarioError(f"devices.{key} must be 0-{most:g}, got {value}")
     if optional["synthesis"] and not optional["devices"]:
         raise ScenarioError("[synthesis] needs a [devices] table (the VR stream it runs on)")
     synthesis = optional["synthesis"]
@@ -241,6 +262,8 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
         )
     if synthesis and not 0 <= synthesis.arm_ik <= 1:
         raise ScenarioError(f"synthesis.arm_ik must be 0-1, got {synthesis.arm_ik}")
+    if motion.corrupt is not None and motion.corrupt not in CORRUPTIONS:
+        raise ScenarioError(f"motion.corrupt must be one of {CORRUPTIONS}, got {motion.corrupt!r}")
     if not 0 < motion.duration_s <= MAX_MOTION_S:
         raise ScenarioError(
             f"motion.duration_s must be above 0 and at most {MAX_MOTION_S:g}, "
@@ -281,6 +304,13 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
     physics = data.get("physics", {})
     if not isinstance(physics, dict):
         raise ScenarioError("[physics] must be a table of check settings")
+    expect_fail = _check_type(data.get("expect_fail", []), tuple[str, ...], "expect_fail")
+    regression = data.get("regression", {})
+    if not isinstance(regression, dict):
+        raise ScenarioError("[regression] must be a table of metric = tolerance")
+    regression = {k: _check_type(v, float, f"regression.{k}") for k, v in regression.items()}
+    if any(not 0 <= v < float("inf") for v in regression.values()):
+        raise ScenarioError("[regression] tolerances must be finite numbers, 0 or more")
     seed = _check_type(data.get("seed", 0), int, "seed")
     if seed < 0:
         raise ScenarioError(f"seed must be 0 or more, got {seed}")
@@ -293,6 +323,8 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
         **optional,
         thresholds=thresholds,
         physics=physics,
+        expect_fail=expect_fail,
+        regression=regression,
         path=path,
     )
 

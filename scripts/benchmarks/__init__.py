@@ -19,6 +19,7 @@ BENCHMARKS: dict[str, str] = {
     "cameras": "cameras",
     "kinect": "kinect",
     "tracking": "tracking",
+    "suite": "suite",
 }
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
+from render_cams.vr.dropouts import Dropouts
 from render_cams.vr.noise import Drift, Latency, PositionJitter, RotationJitter
 from scripts.run_context import RunContext
 from scripts.scenario import Scenario
@@ -22,6 +23,12 @@ def setup(ctx: RunContext) -> VRSetup:
     spec = ctx.scenario.devices
     devices = FULL_BODY if spec.trackers else HEADSET_AND_CONTROLLERS
     noise = REALISTIC_NOISE if spec.noise == "realistic" else ()
+    sweep = (
+        (spec.latency_s, lambda: Latency(seconds=spec.latency_s)),
+        (spec.jitter_m, lambda: PositionJitter(sigma_m=spec.jitter_m)),
+        (spec.dropouts_per_s, lambda: Dropouts(bursts_per_s=spec.dropouts_per_s)),
+    )
+    noise += tuple(model() for amount, model in sweep if amount > 0)
     return VRSetup(devices=devices, noise=noise)
 
 

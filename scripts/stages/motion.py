@@ -10,6 +10,7 @@ from avatar_models.errors import MotionValueError
 from avatar_models.formats import load_motion, save_motion
 from avatar_models.generator import ACTIVITIES, generate, sample_subject
 from avatar_models.measure import check_plausible_height
+from scripts.corruption import corrupted
 from scripts.run_context import RunContext
 from scripts.scenario import MIN_FRAMES, ScenarioError
 
@@ -44,6 +45,8 @@ def run(ctx: RunContext) -> None:
             check_plausible_height(motion)
         except MotionValueError as exc:
             raise ScenarioError(f"motion {spec.source}: {exc} (motion.unit)") from None
+    if spec.corrupt is not None:
+        motion = corrupted(motion, spec.corrupt, ctx.scenario.seed)
     ctx.motion = motion
     ctx.metrics["frames"] = float(motion.n_frames)
     ctx.info["motion"] = {
@@ -56,5 +59,6 @@ def run(ctx: RunContext) -> None:
         "frames": motion.n_frames,
         "duration_s": motion.duration_s,
         "subject": motion.meta.get("subject"),
+        "corrupt": spec.corrupt,
     }
     ctx.output("motion_bvh", save_motion(motion, ctx.out_dir / "motion.bvh"))

@@ -35,6 +35,12 @@ def test_default_scenario_is_valid():
         ({"thresholds": {"x": {"maximum": 1}}}, "must be a number"),
         ({"tracking": {"seconds": 0}}, "tracking.seconds must be above 0"),
         ({"tracking": {"search": "yes"}}, "tracking.search must be bool"),
+        ({"expect_fail": "frames"}, "expect_fail must be a list"),
+        ({"regression": {"frames": -1}}, "tolerances must be finite numbers, 0 or more"),
+        ({"regression": {"frames": "big"}}, "regression.frames must be float"),
+        ({"motion": {"corrupt": "melt"}}, "motion.corrupt must be one of"),
+        ({"devices": {"latency_s": 5.0}}, "devices.latency_s must be 0-1"),
+        ({"devices": {"dropouts_per_s": -1}}, "devices.dropouts_per_s must be 0-10"),
     ],
 )
 def test_invalid_scenarios_name_the_problem(data, message):

@@ -1,0 +1,25 @@
+"""Check rows: an expected failure passes when its threshold is missed, fails when met."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+from scripts.results import ThresholdResult, junit_xml
+from scripts.scenario import Threshold
+
+
+def test_expected_failure_turns_the_verdict_round():
+    missed = ThresholdResult("float_cm_p95", 15.0, Threshold(max=5.0), expected_fail=True)
+    met = ThresholdResult("float_cm_p95", 1.0, Threshold(max=5.0), expected_fail=True)
+    assert missed.passed and missed.to_json()["expected_fail"] is True
+    assert not met.passed
+    assert met.failure_message() == "1 is <= 5, but expected to fail"
+    root = ET.fromstring(junit_xml("s", [missed, met]))
+    assert root.get("failures") == "1"
+    failed = [c.get("name") for c in root.iter("testcase") if c.find("failure") is not None]
+    assert failed == ["float_cm_p95"] and len(list(root.iter("testcase"))) == 2
+
+
+def test_a_plain_check_has_no_expected_fail_key():
+    row = ThresholdResult("frames", 3.0, Threshold(max=5.0)).to_json()
+    assert "expected_fail" not in row and row["passed"]
