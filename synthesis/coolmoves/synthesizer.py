@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from avatar_models import Skeleton, quat
+from avatar_models.body.description import UPRIGHT_RATIO
 from avatar_models.measure import standing_height
 from avatar_models.rigs import identify_rig
 from render_cams.vr import nominal_attachment
@@ -180,7 +181,8 @@ class CoolMoves(Synthesizer):
         head_rest = rest[self._head_chain[-1]] + self._eye
         self._ref_height = standing_height(ref)
         self._ref_hmd_height = float(head_rest[2] - rest[:, 2].min())
-        upright = self._ref_hmd_height >= 0.8 * self._ref_height
+        # The body's test of a standing rest pose, on the headset height over stature.
+        upright = self._ref_hmd_height >= UPRIGHT_RATIO * self._ref_height
         if not upright:
             # A rest pose that is not upright (Bandai's): eye height from stature instead.
             self._ref_hmd_height = EYE_HEIGHT_FRAC * self._ref_height
