@@ -73,11 +73,6 @@ class TrackingFrame:
             stream.valid[index],
         )
 
-    def usable(self) -> np.ndarray:
-        """``(D,)`` bool: marked valid and holding a finite pose."""
-        finite = np.isfinite(self.positions).all(-1) & np.isfinite(self.quaternions).all(-1)
-        return np.asarray(self.valid, bool) & finite
-
 
 @dataclass(frozen=True, eq=False)
 class Pose:

@@ -14,6 +14,11 @@ Invalid input: a hand is matched only when its whole window (and the headset) wa
 a side without matches holds its limb (EWMA weight 0), with no match at all the whole pose
 holds, and the translation holds the last tracked headset position. Late or repeated
 timestamps are ignored by ``step``; ``run`` repairs and re-clocks the stream first.
+
+The method is written once, over a batch of frames (:meth:`CoolMoves.advance`): ``step`` is a
+batch of one, ``run`` the whole stream (:mod:`synthesis.base`). Its state between calls: the
+last window of hand samples, the smoothed pose, the last headset position and bone scale,
+and the foot-contact state.
 """
 
 from __future__ import annotations
