@@ -30,7 +30,6 @@ or decays its output through them.
 from __future__ import annotations
 
 from abc import ABC, abstractmethod
-from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -133,19 +132,6 @@ class FrameBatch:
         finite = np.isfinite(self.positions).all(-1) & np.isfinite(self.quaternions).all(-1)
         return np.asarray(self.valid, bool) & finite
 
-    def device_index(self, devices: Sequence[str], method: str) -> np.ndarray:
-        """Indices ``(len(devices),)`` of ``devices`` along ``D``.
-
-        Raises:
-            SynthesisError: a device ``method`` needs is not in the batch.
-        """
-        missing = [d for d in devices if d not in self.device_names]
-        if missing:
-            raise SynthesisError(
-                f"{method} needs devices {missing}; the stream has {self.device_names}"
-            )
-        return np.array([self.device_names.index(d) for d in devices])
-
 
 @dataclass(frozen=True, eq=False)
 class Poses:
@@ -247,10 +233,28 @@ class Synthesizer(ABC):
         """What distinguishes this instance in the output's ``meta`` (e.g. its options)."""
         return {}
 
+    def device_index(self, frames: FrameBatch) -> np.ndarray:
+        """Indices ``(len(devices),)`` of :attr:`devices` along the frames' ``D`` axis
+        (cached per device list: ``step`` asks once per sample).
+
+        Raises:
+            SynthesisError: a device the method needs is not in the frames.
+        """
+        names = frames.device_names
+        cached = self._device_index
+        if cached is None or cached[0] != names:
+            missing = [d for d in self.devices if d not in names]
+            if missing:
+                raise SynthesisError(f"{self.name} needs devices {missing}; the stream has {names}")
+            cached = (names, np.array([names.index(d) for d in self.devices]))
+            self._device_index = cached
+        return cached[1]
+
     def reset(self) -> None:
         """Forget all state (start of a new session)."""
         self._last_time: float | None = None
         self._last_pose: Pose | None = None
+        self._device_index: tuple[tuple[str, ...], np.ndarray] | None = None
         self.reset_state()
 
     def step(self, frame: TrackingFrame) -> Pose:

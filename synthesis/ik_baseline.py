@@ -339,7 +339,7 @@ class IKBaseline(Synthesizer):
 
     def advance(self, frames: FrameBatch) -> Poses:
         """One warm-started solve per frame, in order (each starts from the previous one)."""
-        index = frames.device_index(self.devices, "the IK baseline")
+        index = self.device_index(frames)
         ok = frames.usable()[:, index]
         qpos = np.stack(
             [

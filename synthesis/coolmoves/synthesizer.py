@@ -346,14 +346,11 @@ class CoolMoves(Synthesizer):
         """Poses for ``B`` consecutive frames; carries the last window, the smoothed pose, the
         headset and the foot contacts from the previous call (``step`` is a batch of one)."""
         n, b = self.database.window_samples, frames.size
-        head, left, right = frames.device_index(self.devices, self.name)
-        ok = frames.usable()
-        sides_ok = ok[:, [left, right]] & ok[:, [head]]
-        rel = np.where(
-            sides_ok[..., None],
-            frames.positions[:, [left, right]] - frames.positions[:, [head]],
-            np.nan,
-        )
+        index = self.device_index(frames)  # head, left, right
+        drivers = frames.positions[:, index]  # (B, 3, 3)
+        ok = frames.usable()[:, index]
+        sides_ok = ok[:, 1:] & ok[:, :1]
+        rel = np.where(sides_ok[..., None], drivers[:, 1:] - drivers[:, :1], np.nan)
         # The last n - 1 samples before this batch complete its first windows.
         padded_rel = np.concatenate([self._window[1:], rel])
         padded_ok = np.concatenate([self._tracked[1:], sides_ok])
@@ -361,19 +358,22 @@ class CoolMoves(Synthesizer):
         ends = np.arange(n - 1, n - 1 + b)
         windows = sliding_windows(padded_rel, ends, n)  # (B, n, 2, 3)
         window_ok = sliding_windows(padded_ok, ends, n).all(axis=1)  # (B, 2)
-        blended = np.zeros((b, self.database.skeleton.n_joints, 4))
-        weight = np.zeros((b, self.database.skeleton.n_joints))
         rows = np.flatnonzero(window_ok.any(axis=1))
-        if rows.size:
-            blended[rows], weight[rows] = self.match(windows[rows], window_ok[rows])
+        if rows.size == b:  # every frame has a window (a tracked stream, or one step)
+            blended, weight = self.match(windows, window_ok)
+        else:  # frames without any window get no match: zero weight, the state holds
+            blended = np.zeros((b, self.database.skeleton.n_joints, 4))
+            weight = np.zeros((b, self.database.skeleton.n_joints))
+            if rows.size:
+                blended[rows], weight[rows] = self.match(windows[rows], window_ok[rows])
         # A joint's first match replaces the initial mean pose outright.
         matched = weight > 0
         seen_before = np.concatenate([self._initialised[None], matched[:-1]]).cumsum(0) > 0
         self._initialised = seen_before[-1] | matched[-1]
         smoothed = ewma(blended, np.where(seen_before, weight, matched), self._state)
         self._state = smoothed[-1]
-        hmd, scale = self._hmd_track(frames.positions[:, head], ok[:, head])
-        hands = np.where(sides_ok[..., None], frames.positions[:, [left, right]], 0.0)
+        hmd, scale = self._hmd_track(drivers[:, 0], ok[:, 0])
+        hands = np.where(sides_ok[..., None], drivers[:, 1:], 0.0)
         rotations, root = self._finish(smoothed, hmd, scale, hands, sides_ok)
         return Poses(root, rotations)
 
