@@ -6,13 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import Motion, Skeleton
 from avatar_models.generator import Subject, generate
 from render_cams import VRSetup
-from synthesis.base import FrameBatch, Poses, SynthesisError, Synthesizer
+from synthesis.base import SynthesisError
 from synthesis.coolmoves import CoolMoves
 from synthesis.scoring import GROUPS, body17_errors_cm, hand_correlation, score_run
-from tests.synthesis.conftest import TEST_SUBJECT
+from tests.synthesis.conftest import TEST_SUBJECT, TruthReplay
 
 
 def test_errors_by_group_on_a_known_offset():
@@ -21,29 +20,6 @@ def test_errors_by_group_on_a_known_offset():
     moved = truth.translated(np.array([0.0, 0.03, 0.04]))
     err = body17_errors_cm(moved, truth, skip=0)
     assert err == pytest.approx({"hands": 5.0, "upper": 5.0, "lower": 5.0, "full": 5.0})
-
-
-class TruthReplay(Synthesizer):
-    """A perfect method: the ground truth, frame by frame."""
-
-    name = "truth"
-    devices = ("hmd",)
-
-    def __init__(self, truth: Motion):
-        self.truth = truth
-        self.reset()
-
-    @property
-    def skeleton(self) -> Skeleton:
-        return self.truth.skeleton
-
-    def reset_state(self) -> None:
-        self.frame = 0
-
-    def advance(self, frames: FrameBatch) -> Poses:
-        rows = np.minimum(self.frame + np.arange(frames.size), self.truth.n_frames - 1)
-        self.frame += frames.size
-        return Poses(self.truth.root_pos[rows], self.truth.local_rot[rows])
 
 
 def test_a_perfect_method_scores_zero_error_and_full_correlation(test_motion):
