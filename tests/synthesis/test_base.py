@@ -75,7 +75,7 @@ class HeadsetCounter(Synthesizer):
         self.count = 0
 
     def advance(self, frames: FrameBatch) -> Poses:
-        (hmd,) = frames.device_index(self.devices, self.name)
+        (hmd,) = self.device_index(frames)
         counts = self.count + np.cumsum(frames.usable()[:, hmd])
         self.count = int(counts[-1])
         root = np.stack([counts, frames.timestamps, np.zeros(frames.size)], axis=-1)
