@@ -42,7 +42,7 @@ from avatar_models.body.ik import HumanoidIK, IKSettings, humanoid_model, motion
 from avatar_models.measure import standing_height
 from render_cams import TrackingStream
 from render_cams.vr import HEADSET_AND_CONTROLLERS, Attachment, nominal_attachment
-from synthesis.base import Pose, SynthesisError, Synthesizer, TrackingFrame, on_clock
+from synthesis.base import DEFAULT_RATE_HZ, FrameBatch, Poses, SynthesisError, Synthesizer
 
 STEERED_SITES = ("head", "l_wrist", "r_wrist", "pelvis", "l_ankle", "r_ankle")
 """The humanoid's body17 sites the IK steers, in target order."""
@@ -187,6 +187,7 @@ class IKBaseline(Synthesizer):
     """
 
     name = "ik"
+    devices = HEADSET_AND_CONTROLLERS
 
     def __init__(
         self,
@@ -240,20 +241,14 @@ class IKBaseline(Synthesizer):
     def skeleton(self) -> Skeleton:
         return self.body.skeleton
 
-    def reset(self) -> None:
+    def reset_state(self) -> None:
         self._q = self.ik.posture.copy()
         self._solved = False
         self._joints: np.ndarray | None = None  # (3, 7) last head/wrist positions + wxyz
         self._stepper: Stepper | None = None
-        self._last_time: float | None = None
+        self._previous_time: float | None = None
         self._last_pelvis: np.ndarray | None = None
         self._velocity = np.zeros(3)
-
-    def _device_index(self, names: tuple[str, ...]) -> np.ndarray:
-        missing = [d for d in HEADSET_AND_CONTROLLERS if d not in names]
-        if missing:
-            raise SynthesisError(f"the IK baseline needs devices {missing}; the stream has {names}")
-        return np.array([names.index(d) for d in HEADSET_AND_CONTROLLERS])
 
     def joint_targets(self, positions: np.ndarray, quaternions: np.ndarray) -> np.ndarray:
         """Head, left and right wrist ``(3, 7)`` (position, wxyz) from the device poses
@@ -292,20 +287,19 @@ class IKBaseline(Synthesizer):
         neutral[:, 2] = np.maximum(neutral[:, 2], self._rest_sites[4:, 2])
         return pelvis, neutral, lean < GROUNDED_LEAN_RAD, body
 
-    def _solve(self, frame: TrackingFrame) -> np.ndarray:
-        """The qpos ``(nq,)`` for one tracking sample (state advanced)."""
+    def _solve(
+        self, timestamp: float, positions: np.ndarray, quaternions: np.ndarray, ok: np.ndarray
+    ) -> np.ndarray:
+        """The qpos ``(nq,)`` after one tracking sample of the hmd and both controllers:
+        ``positions (3, 3)``, ``quaternions (3, 4)``, usable ``ok (3,)`` (state advanced)."""
         dt = 1.0 / 90.0
-        if self._last_time is not None:
-            if not frame.timestamp > self._last_time:
-                return self._q  # a late or repeated sample: already past it
-            dt = float(frame.timestamp) - self._last_time
-        if np.isfinite(frame.timestamp):
-            self._last_time = float(frame.timestamp)
-        index = self._device_index(frame.device_names)
-        ok = frame.usable()[index]
+        if self._previous_time is not None:
+            dt = float(timestamp) - self._previous_time
+        if np.isfinite(timestamp):
+            self._previous_time = float(timestamp)
         fresh = self.joint_targets(
-            np.where(ok[:, None], frame.positions[index], 0.0),
-            np.where(ok[:, None], frame.quaternions[index], quat.IDENTITY),
+            np.where(ok[:, None], positions, 0.0),
+            np.where(ok[:, None], quaternions, quat.IDENTITY),
         )
         if self._joints is None:
             if not ok[0]:
@@ -343,21 +337,22 @@ class IKBaseline(Synthesizer):
         self._q, _, _ = self.ik.solve_frame(positions, start, orientations, iterations)
         return self._q
 
-    def step(self, frame: TrackingFrame) -> Pose:
-        pose = motion_from_qpos(self.body, self._solve(frame)[None], 90.0)
-        return Pose(pose.root_pos[0], pose.local_rot[0])
+    def advance(self, frames: FrameBatch) -> Poses:
+        """One warm-started solve per frame, in order (each starts from the previous one)."""
+        index = self.device_index(frames)
+        ok = frames.usable()[:, index]
+        qpos = np.stack(
+            [
+                self._solve(t, p[index], q[index], usable)
+                for t, p, q, usable in zip(
+                    frames.timestamps, frames.positions, frames.quaternions, ok, strict=True
+                )
+            ]
+        )
+        motion = motion_from_qpos(self.body, qpos, DEFAULT_RATE_HZ)
+        return Poses(motion.root_pos, motion.local_rot)
 
     def run(self, stream: TrackingStream) -> Motion:
-        """Every tick of the re-clocked stream in order; the same result as :meth:`step`."""
-        clocked = on_clock(stream)
-        self.reset()
         # The QPs are small: BLAS threads cost more than they save (see avatar_models.body.ik).
         with threadpool_limits(1, user_api="blas"):
-            qpos = np.stack(
-                [
-                    self._solve(TrackingFrame.from_stream(clocked, i))
-                    for i in range(clocked.n_samples)
-                ]
-            )
-        motion = motion_from_qpos(self.body, qpos, float(clocked.meta["rate_hz"]))
-        return motion.replace(meta={"method": self.name, "stream": clocked.meta})
+            return super().run(stream)

@@ -18,24 +18,13 @@ import numpy as np
 from avatar_models.generator import generate, sample_subject
 from render_cams import VRSetup
 from scripts.benchmarks import BenchRow, best_of
-from synthesis.base import TrackingFrame
 from synthesis.coolmoves import CoolMoves, Options, build_database
-from synthesis.coolmoves.accuracy import PAPER_ACTIVITIES
+from synthesis.evaluate import PAPER_ACTIVITIES
+from synthesis.scoring import step_latencies_ms
 
 PAPER_BACKEND_MS = 1000.0 / 152.0
 PAPER_GMM_MS = 1000.0 / 44.0
 FRAME_BUDGET_MS = 1000.0 / 90.0
-
-
-def _step_latencies_ms(synth: CoolMoves, stream) -> np.ndarray:
-    frames = [TrackingFrame.from_stream(stream, i) for i in range(stream.n_samples)]
-    synth.reset()
-    out = np.empty(len(frames))
-    for i, frame in enumerate(frames):
-        t0 = time.perf_counter()
-        synth.step(frame)
-        out[i] = time.perf_counter() - t0
-    return 1e3 * out
 
 
 def run(quick: bool = False) -> list[BenchRow]:
@@ -53,12 +42,12 @@ def run(quick: bool = False) -> list[BenchRow]:
     held_out = subjects[-1]
     stream = VRSetup().sample(generate("box", held_out, 4.0 if quick else 8.0, 90.0, seed=99))
     synth = CoolMoves(database, held_out.height_m)
-    lat = _step_latencies_ms(synth, stream)
+    lat = step_latencies_ms(synth, stream)
     batch_s = best_of(lambda: synth.run(stream), repeat=2 if quick else 3)
     paper = CoolMoves(database, held_out.height_m, Options(arm_ik=0.0))
-    paper_lat = _step_latencies_ms(paper, stream)
+    paper_lat = step_latencies_ms(paper, stream)
     gmm = CoolMoves(database, held_out.height_m, Options(matcher="gmm"))
-    gmm_lat = _step_latencies_ms(gmm, stream[: 180 if quick else 360])
+    gmm_lat = step_latencies_ms(gmm, stream[: 180 if quick else 360])
     note = f"{database.n_windows} windows, {stream.n_samples} frames"
     return [
         BenchRow(

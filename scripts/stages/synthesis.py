@@ -8,16 +8,16 @@ import numpy as np
 from avatar_models.generator import generate_library
 from avatar_models.measure import standing_height
 from avatar_models.motion import Motion
+from scripts.method_score import score_method
 from scripts.run_context import RunContext
 from scripts.scenario import Scenario, ScenarioError
-from sim.humanoid import Humanoid, humanoid_for
-from sim.plausibility import check_humanoid
+from scripts.stages.physics import config as physics_config
+from sim.humanoid import Humanoid
 from synthesis.base import Synthesizer
 from synthesis.coolmoves import CoolMoves, Options, build_database
-from synthesis.coolmoves.accuracy import body17_errors_cm, hand_correlation
+from synthesis.scoring import GROUPS
 
 METHODS = ("coolmoves", "ik")
-GROUPS = ("hands", "upper", "lower", "full")
 
 METRICS = {
     **{
@@ -79,20 +79,21 @@ def run(ctx: RunContext) -> None:
     user_height_m = (subject.get("height_m") if isinstance(subject, dict) else None) or (
         standing_height(ctx.motion)
     )
+    checks = physics_config(ctx)  # the scenario's [physics] settings, as for the ground truth
     outputs: dict[str, Humanoid] = {}
     for method in spec.methods:
-        output = make_synthesizer(method, ctx, user_height_m).run(stream)
-        outputs[method] = humanoid = humanoid_for(output)
-        for group, value in body17_errors_cm(output, ctx.motion).items():
+        synth = make_synthesizer(method, ctx, user_height_m)
+        result = score_method(synth, ctx.motion, stream, checks)
+        outputs[method] = result.humanoid
+        score = result.score
+        for group, value in score.err_cm.items():
             ctx.metrics[f"{method}_err_cm_{group}"] = value
-        corr = hand_correlation(output, stream)
-        ctx.metrics[f"{method}_hand_corr_min"] = min(corr.values())
-        physics = check_humanoid(humanoid).values
-        ctx.metrics[f"{method}_skate_cm_s_median"] = physics["skate_cm_s_median"]
-        ctx.metrics[f"{method}_penetration_cm_p95"] = physics["penetration_cm_p95"]
+        ctx.metrics[f"{method}_hand_corr_min"] = min(score.hand_corr.values())
+        for key in ("skate_cm_s_median", "penetration_cm_p95"):
+            ctx.metrics[f"{method}_{key}"] = result.physics[key]
         ctx.info.setdefault("synthesis", {})[method] = {
-            "frames": output.n_frames,
-            "hand_corr": corr,
-            "err_cm": {g: ctx.metrics[f"{method}_err_cm_{g}"] for g in GROUPS},
+            "frames": score.frames,
+            "hand_corr": score.hand_corr,
+            "err_cm": score.err_cm,
         }
     ctx.synthesised = outputs

@@ -3,8 +3,12 @@ controllers, by nearest-neighbour matching of 100 ms hand windows into a stylise
 
 One concept per module: :mod:`.features` (windows, features, speed augmentation),
 :mod:`.correlation` (hand-foot Pearson filter), :mod:`.database`, :mod:`.knn`, :mod:`.gmm`
-(the mixture-model variant), :mod:`.alignment`, :mod:`.blend`, :mod:`.smoothing`,
-:mod:`.limits`, :mod:`.synthesizer`, :mod:`.applications` and :mod:`.accuracy`.
+(the mixture-model matcher: the variant is ``CoolMoves`` with ``Options(matcher="gmm")``),
+:mod:`.alignment`, :mod:`.blend`, :mod:`.smoothing`, :mod:`.limits`, :mod:`.two_bone`,
+:mod:`.foot_contact`, :mod:`.synthesizer` (the method as a
+:class:`~synthesis.base.Synthesizer`), :mod:`.applications` (§5, run from Python: see the
+README) and :mod:`.accuracy` (foot skating of the output). Accuracy against the ground truth
+is :mod:`synthesis.scoring`.
 """
 
 from synthesis.coolmoves.database import (

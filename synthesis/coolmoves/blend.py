@@ -81,7 +81,11 @@ def joint_groups(limb_masks: np.ndarray) -> np.ndarray:
 def global_match_weight(confidence: np.ndarray, groups: np.ndarray) -> np.ndarray:
     """``(B,)`` mean over all joints of their group's confidence."""
     counts = np.bincount(groups, minlength=3).astype(float)
-    return confidence @ (counts / counts.sum())
+    # One row would take numpy's vector-dot path, whose rounding differs from the matrix-
+    # vector product of a batch by an ulp (amplified to 1e-12 in the final rotations): a
+    # batch of one is computed as two rows, so streaming stays bit-identical to batch.
+    rows = confidence if confidence.shape[0] > 1 else np.repeat(confidence, 2, axis=0)
+    return (rows @ (counts / counts.sum()))[: confidence.shape[0]]
 
 
 def blend_rotations(rotations: np.ndarray, weights: np.ndarray) -> np.ndarray:

@@ -15,6 +15,10 @@ detail; ours:
    (in place of the inverse distance of the nearest-neighbour method).
 
 Every query evaluates all ``N`` windows under their local metric: that is what makes it slower.
+
+The variant is :class:`~synthesis.coolmoves.CoolMoves` with ``Options(matcher="gmm")``: the
+same :class:`~synthesis.base.Synthesizer` and core, with this matcher in place of the KD-tree
+(``coolmoves-gmm`` in ``avatarsim eval``).
 """
 
 from __future__ import annotations

@@ -5,7 +5,7 @@ neighborhood distance threshold, using the L2 norm as our distance metric", sepa
 the left and the right hand. The paper's Fig. 3 shows the top 5 matches per hand, hence
 ``K_NEIGHBOURS = 5``. The paper gives no value for the threshold; ours is in the units of
 :mod:`.features` (metres over one window) and was chosen on the built-in generator's
-cross-subject split (see ``synthesis.coolmoves.accuracy``).
+cross-subject split (see ``synthesis.evaluate``).
 """
 
 from __future__ import annotations

@@ -22,8 +22,8 @@ import numpy as np
 from avatar_models import Skeleton
 from avatar_models.body.anatomy import classify
 from avatar_models.body.joint_ranges import euler_order
+from avatar_models.quat import euler_axes, from_euler, to_euler
 from avatar_models.rigs import RigError, identify_rig
-from synthesis.coolmoves.rotations import euler_axes, from_euler, to_euler
 
 _DEFAULT_ORDER = "XYZ"
 

@@ -14,6 +14,11 @@ Invalid input: a hand is matched only when its whole window (and the headset) wa
 a side without matches holds its limb (EWMA weight 0), with no match at all the whole pose
 holds, and the translation holds the last tracked headset position. Late or repeated
 timestamps are ignored by ``step``; ``run`` repairs and re-clocks the stream first.
+
+The method is written once, over a batch of frames (:meth:`CoolMoves.advance`): ``step`` is a
+batch of one, ``run`` the whole stream (:mod:`synthesis.base`). Its state between calls: the
+last window of hand samples, the smoothed pose, the last headset position and bone scale,
+and the foot-contact state.
 """
 
 from __future__ import annotations
@@ -22,12 +27,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import Motion, Skeleton, quat
+from avatar_models import Skeleton, quat
+from avatar_models.body.description import UPRIGHT_RATIO
 from avatar_models.measure import standing_height
 from avatar_models.rigs import identify_rig
-from render_cams import TrackingStream
 from render_cams.vr import nominal_attachment
-from synthesis.base import Pose, SynthesisError, Synthesizer, TrackingFrame, on_clock, usable_mask
+from synthesis.base import FrameBatch, Poses, SynthesisError, Synthesizer
 from synthesis.coolmoves.alignment import alignment_yaw
 from synthesis.coolmoves.blend import (
     blend_rotations,
@@ -40,7 +45,7 @@ from synthesis.coolmoves.features import RATE_HZ, search_vectors, sliding_window
 from synthesis.coolmoves.foot_contact import FootContact
 from synthesis.coolmoves.knn import K_NEIGHBOURS, MAX_DISTANCE, BothHandsKNN, PerHand
 from synthesis.coolmoves.limits import JointLimits
-from synthesis.coolmoves.smoothing import ewma, ewma_step
+from synthesis.coolmoves.smoothing import ewma
 from synthesis.coolmoves.two_bone import chain_fk
 from synthesis.coolmoves.two_bone import solve as two_bone
 
@@ -167,6 +172,7 @@ class CoolMoves(Synthesizer):
         options: Options | None = None,
     ):
         self.database = database
+        self.devices = tuple(database.drivers.devices)
         self.options = options or Options()
         self.user_height_m = user_height_m
         self._matcher = self._make_matcher()
@@ -180,7 +186,8 @@ class CoolMoves(Synthesizer):
         head_rest = rest[self._head_chain[-1]] + self._eye
         self._ref_height = standing_height(ref)
         self._ref_hmd_height = float(head_rest[2] - rest[:, 2].min())
-        upright = self._ref_hmd_height >= 0.8 * self._ref_height
+        # The body's test of a standing rest pose, on the headset height over stature.
+        upright = self._ref_hmd_height >= UPRIGHT_RATIO * self._ref_height
         if not upright:
             # A rest pose that is not upright (Bandai's): eye height from stature instead.
             self._ref_hmd_height = EYE_HEIGHT_FRAC * self._ref_height
@@ -216,23 +223,23 @@ class CoolMoves(Synthesizer):
         raise SynthesisError(f"unknown matcher {opts.matcher!r}; use 'knn' or 'gmm'")
 
     # -- state ----------------------------------------------------------------------------
-    def reset(self) -> None:
+    def reset_state(self) -> None:
         n = self.database.window_samples
-        self._window = np.full((n, 2, 3), np.nan)
+        self._window = np.full((n, 2, 3), np.nan)  # the last n head-relative hand samples
         self._tracked = np.zeros((n, 2), bool)
-        self._state = self.database.mean_pose.copy()
+        self._state = self.database.mean_pose.copy()  # the smoothed pose (J, 4)
         self._initialised = np.zeros(self.database.skeleton.n_joints, bool)
-        self._hmd: np.ndarray | None = None
+        self._hmd: np.ndarray | None = None  # the last tracked headset position
         self._scale: float | None = self._scale_for(self.user_height_m)
-        self._last_time: float | None = None
-        self._last_pose: Pose | None = None
-        self._device_index: tuple[tuple[str, ...], np.ndarray] | None = None
         self._feet = FootContact(RATE_HZ)
 
     @property
     def skeleton(self) -> Skeleton:
         """The output rig: the database rig scaled to the user's height (once known)."""
         return self.database.skeleton.scaled(self._scale or 1.0)
+
+    def settings(self) -> dict:
+        return {"options": vars(self.options)}
 
     @property
     def standing_ankle_height(self) -> float:
@@ -245,16 +252,6 @@ class CoolMoves(Synthesizer):
     def _scale_from_hmd(self, hmd_z: float) -> float:
         """Bone scale from a standing headset height (the reference rig's HMD height ratio)."""
         return self._scale_for(hmd_z * self._ref_height / self._ref_hmd_height)
-
-    def _devices(self, names: tuple[str, ...]) -> np.ndarray:
-        """Indices of (head, left, right) drivers in a stream's device list, cached."""
-        if self._device_index is None or self._device_index[0] != names:
-            missing = [d for d in self.database.drivers.devices if d not in names]
-            if missing:
-                raise SynthesisError(f"CoolMoves needs devices {missing}; the stream has {names}")
-            index = np.array([names.index(d) for d in self.database.drivers.devices])
-            self._device_index = (names, index)
-        return self._device_index[1]
 
     # -- the method, on a batch of windows ------------------------------------------------
     def match(self, windows: np.ndarray, tracked: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -344,93 +341,54 @@ class CoolMoves(Synthesizer):
     def _default_hmd(self) -> np.ndarray:
         return np.array([0.0, 0.0, self._ref_hmd_height])
 
-    # -- streaming ------------------------------------------------------------------------
-    def step(self, frame: TrackingFrame) -> Pose:
-        if self._last_time is not None and not frame.timestamp > self._last_time:
-            return self._last_pose  # a late or repeated sample: already past it
-        if np.isfinite(frame.timestamp):
-            self._last_time = float(frame.timestamp)
-        head, left, right = self._devices(frame.device_names)
-        ok = frame.usable()
-        sides_ok = ok[[left, right]] & ok[head]
-        self._window[:-1] = self._window[1:]
-        self._tracked[:-1] = self._tracked[1:]
-        self._window[-1] = np.where(
-            sides_ok[:, None], frame.positions[[left, right]] - frame.positions[head], np.nan
-        )
-        self._tracked[-1] = sides_ok
-        if ok[head]:
-            self._hmd = np.array(frame.positions[head], float)
-            if self._scale is None:
-                self._scale = self._scale_from_hmd(self._hmd[2])
-        window_ok = self._tracked.all(axis=0)
-        if window_ok.any():
-            blended, weight = self.match(self._window[None], window_ok[None])
-            blended, weight = blended[0], weight[0]
-            weight = np.where(self._initialised, weight, weight > 0)
-            self._state = ewma_step(self._state, blended, weight)
-            self._initialised |= weight > 0
-        hmd = self._default_hmd() if self._hmd is None else self._hmd
-        hands = np.where(sides_ok[:, None], frame.positions[[left, right]], 0.0)
-        rotations, root = self._finish(
-            self._state[None],
-            hmd[None],
-            np.array([self._scale or 1.0]),
-            hands[None],
-            sides_ok[None],
-        )
-        self._last_pose = Pose(root[0], rotations[0])
-        return self._last_pose
-
-    # -- batch ----------------------------------------------------------------------------
-    def run(self, stream: TrackingStream) -> Motion:
-        """The whole stream at once; the same result as :meth:`step` on every clock tick."""
-        self.reset()
-        clocked = on_clock(stream)
-        n, t = self.database.window_samples, clocked.n_samples
-        head, left, right = self._devices(clocked.device_names)
-        ok = usable_mask(clocked)
-        sides_ok = ok[:, [left, right]] & ok[:, [head]]
-        rel = np.where(
-            sides_ok[..., None],
-            clocked.positions[:, [left, right]] - clocked.positions[:, [head]],
-            np.nan,
-        )
-        padded_rel = np.concatenate([np.full((n - 1, 2, 3), np.nan), rel])
-        padded_ok = np.concatenate([np.zeros((n - 1, 2), bool), sides_ok])
-        ends = np.arange(n - 1, n - 1 + t)
-        windows = sliding_windows(padded_rel, ends, n)  # (T, n, 2, 3)
-        window_ok = sliding_windows(padded_ok, ends, n).all(axis=1)  # (T, 2)
-        blended = np.zeros((t, self.database.skeleton.n_joints, 4))
-        weight = np.zeros((t, self.database.skeleton.n_joints))
+    # -- the core: a batch of consecutive frames -----------------------------------------
+    def advance(self, frames: FrameBatch) -> Poses:
+        """Poses for ``B`` consecutive frames; carries the last window, the smoothed pose, the
+        headset and the foot contacts from the previous call (``step`` is a batch of one)."""
+        n, b = self.database.window_samples, frames.size
+        index = self.device_index(frames)  # head, left, right
+        drivers = frames.positions[:, index]  # (B, 3, 3)
+        ok = frames.usable()[:, index]
+        sides_ok = ok[:, 1:] & ok[:, :1]
+        rel = np.where(sides_ok[..., None], drivers[:, 1:] - drivers[:, :1], np.nan)
+        # The last n - 1 samples before this batch complete its first windows.
+        padded_rel = np.concatenate([self._window[1:], rel])
+        padded_ok = np.concatenate([self._tracked[1:], sides_ok])
+        self._window, self._tracked = padded_rel[-n:], padded_ok[-n:]
+        ends = np.arange(n - 1, n - 1 + b)
+        windows = sliding_windows(padded_rel, ends, n)  # (B, n, 2, 3)
+        window_ok = sliding_windows(padded_ok, ends, n).all(axis=1)  # (B, 2)
         rows = np.flatnonzero(window_ok.any(axis=1))
-        if rows.size:
-            blended[rows], weight[rows] = self.match(windows[rows], window_ok[rows])
-        # A joint's first match replaces the initial mean pose outright, as in step().
-        seen_before = np.concatenate(
-            [np.zeros((1, weight.shape[1]), bool), np.cumsum(weight > 0, axis=0)[:-1] > 0]
-        )
-        weight = np.where(seen_before, weight, weight > 0)
-        smoothed = ewma(blended, weight, self.database.mean_pose)
-        hmd, scale = self._hmd_track(clocked.positions[:, head], ok[:, head])
-        hands = np.where(sides_ok[..., None], clocked.positions[:, [left, right]], 0.0)
-        rotations, root = self._finish(smoothed, hmd, scale, hands, sides_ok)
+        if rows.size == b:  # every frame has a window (a tracked stream, or one step)
+            blended, weight = self.match(windows, window_ok)
+        else:  # frames without any window get no match: zero weight, the state holds
+            blended = np.zeros((b, self.database.skeleton.n_joints, 4))
+            weight = np.zeros((b, self.database.skeleton.n_joints))
+            if rows.size:
+                blended[rows], weight[rows] = self.match(windows[rows], window_ok[rows])
+        # A joint's first match replaces the initial mean pose outright.
+        matched = weight > 0
+        seen_before = np.concatenate([self._initialised[None], matched[:-1]]).cumsum(0) > 0
+        self._initialised = seen_before[-1] | matched[-1]
+        smoothed = ewma(blended, np.where(seen_before, weight, matched), self._state)
         self._state = smoothed[-1]
-        return Motion(
-            self.skeleton,
-            float(clocked.meta["rate_hz"]),
-            root,
-            rotations,
-            meta={"method": self.name, "options": vars(self.options), "stream": clocked.meta},
-        )
+        hmd, scale = self._hmd_track(drivers[:, 0], ok[:, 0])
+        hands = np.where(sides_ok[..., None], drivers[:, 1:], 0.0)
+        rotations, root = self._finish(smoothed, hmd, scale, hands, sides_ok)
+        return Poses(root, rotations)
 
     def _hmd_track(self, hmd: np.ndarray, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Last tracked headset position per tick ``(T, 3)`` and the bone scale ``(T,)``."""
+        """Last tracked headset position per frame ``(B, 3)`` (before any: the one carried
+        from earlier batches, else the rig's standing headset) and the bone scale ``(B,)``."""
         last = np.maximum.accumulate(np.where(ok, np.arange(ok.size), -1))
-        held = np.where((last >= 0)[:, None], hmd[np.maximum(last, 0)], self._default_hmd())
+        before = self._default_hmd() if self._hmd is None else self._hmd
+        held = np.where((last >= 0)[:, None], hmd[np.maximum(last, 0)], before)
         if self._scale is None and ok.any():
             self._scale = self._scale_from_hmd(float(hmd[np.argmax(ok), 2]))
-        scale = np.where(last >= 0, self._scale or 1.0, 1.0)
+        seen = (last >= 0) | (self._hmd is not None)
+        scale = np.where(seen, self._scale or 1.0, 1.0)
         if self.user_height_m is not None:
             scale[:] = self._scale
+        if seen[-1]:
+            self._hmd = held[-1]
         return held, scale

@@ -22,7 +22,6 @@ from __future__ import annotations
 import numpy as np
 
 from avatar_models import quat
-from synthesis.coolmoves.rotations import to_matrix
 
 _EPS = 1e-12
 _X, _Z = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])
@@ -40,7 +39,7 @@ def chain_fk(
         chain: ``(L,)`` or ``(S, L)`` joint indices from the root, each the parent of the next.
     """
     chain = np.asarray(chain)
-    mats = to_matrix(rotations[:, chain])  # (B, [S,] L, 3, 3)
+    mats = quat.unit_to_matrix(rotations[:, chain])  # (B, [S,] L, 3, 3)
     pos = np.asarray(root, float)
     if chain.ndim == 2:
         pos = np.broadcast_to(pos[:, None], (pos.shape[0], chain.shape[0], 3))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from scipy.spatial.transform import Rotation
 
 from avatar_models import quat
@@ -26,3 +27,14 @@ def test_axis_angle_yaw_and_continuity():
     flipped[1] *= -1
     seq = quat.make_continuous(np.stack([q[0], flipped[1], q[1]]))
     assert np.all(np.sum(seq[1:] * seq[:-1], axis=-1) >= 0)
+
+
+@pytest.mark.parametrize("order", ["XYZ", "YXZ", "ZXY", "XZY", "YZX", "ZYX"])
+def test_numpy_euler_matches_scipy(order):
+    rots = Rotation.random(200, random_state=11)
+    q = quat.from_scipy(rots)[:, None]  # (200, 1, 4): one joint
+    axes = quat.euler_axes(order)
+    np.testing.assert_allclose(quat.to_euler(q, axes)[:, 0], rots.as_euler(order), atol=1e-9)
+    np.testing.assert_allclose(quat.unit_to_matrix(q)[:, 0], rots.as_matrix(), atol=1e-12)
+    back = quat.from_euler(quat.to_euler(q, axes), axes)[:, 0]
+    np.testing.assert_allclose(np.abs(np.sum(back * q[:, 0], axis=-1)), 1.0, atol=1e-12)

@@ -5,7 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from avatar_models import Motion, Skeleton
 from avatar_models.generator import Subject, generate
+from synthesis.base import FrameBatch, Poses, Synthesizer
 from synthesis.coolmoves import build_database
 
 TRAIN_SUBJECTS = (
@@ -38,3 +40,26 @@ def test_motion():
 def yaw_matrix(theta: float) -> np.ndarray:
     c, s = np.cos(theta), np.sin(theta)
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+class TruthReplay(Synthesizer):
+    """A perfect method: the ground truth, frame by frame."""
+
+    name = "truth"
+    devices = ("hmd",)
+
+    def __init__(self, truth: Motion):
+        self.truth = truth
+        self.reset()
+
+    @property
+    def skeleton(self) -> Skeleton:
+        return self.truth.skeleton
+
+    def reset_state(self) -> None:
+        self.frame = 0
+
+    def advance(self, frames: FrameBatch) -> Poses:
+        rows = np.minimum(self.frame + np.arange(frames.size), self.truth.n_frames - 1)
+        self.frame += frames.size
+        return Poses(self.truth.root_pos[rows], self.truth.local_rot[rows])

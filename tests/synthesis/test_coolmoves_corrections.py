@@ -11,9 +11,10 @@ from avatar_models.rigs import identify_rig, load_rig
 from render_cams import VRSetup
 from synthesis.base import TrackingFrame
 from synthesis.coolmoves import CoolMoves, Options, build_database
-from synthesis.coolmoves.accuracy import body17_errors_cm, hand_correlation, stance_skating_cm_s
+from synthesis.coolmoves.accuracy import stance_skating_cm_s
 from synthesis.coolmoves.database import driver_positions
 from synthesis.coolmoves.two_bone import chain_fk, solve
+from synthesis.scoring import body17_errors_cm, hand_correlation
 from tests.synthesis.conftest import TEST_SUBJECT
 
 

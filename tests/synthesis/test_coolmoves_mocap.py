@@ -8,11 +8,12 @@ import pytest
 from avatar_models.library import MotionLibrary
 from avatar_models.rigs import body17_positions
 from render_cams import VRSetup
+from synthesis.base import TrackingFrame
 from synthesis.coolmoves import CoolMoves, build_database
-from synthesis.coolmoves.accuracy import body17_errors_cm
 from synthesis.coolmoves.applications import style_sub_library
 from synthesis.coolmoves.features import search_vectors, sliding_windows
 from synthesis.coolmoves.knn import KNNMatcher
+from synthesis.scoring import body17_errors_cm
 
 STYLES = ("exhausted", "youthful")
 
@@ -59,3 +60,16 @@ def test_style_sub_library_changes_the_output(walks):
     assert np.linalg.norm(a[:n] - b[:n], axis=-1).mean() > 0.03
     own, other = (body17_errors_cm(outputs[s], truth)["full"] for s in STYLES)
     assert own < other
+
+
+@pytest.mark.mocap
+def test_stepping_a_real_clip_is_the_batch_run(walks):
+    """One core: a Bandai take stepped sample by sample is bit for bit the batch run."""
+    truth = walks[("exhausted", 1)]
+    synth = CoolMoves(build_database([walks[("exhausted", 2)], walks[("youthful", 2)]]))
+    stream = VRSetup().sample(truth[: int(3 * truth.fps)], seed=0)
+    batch = synth.run(stream)
+    synth.reset()
+    poses = [synth.step(TrackingFrame.from_stream(stream, i)) for i in range(stream.n_samples)]
+    np.testing.assert_array_equal(np.stack([p.local_rot for p in poses]), batch.local_rot)
+    np.testing.assert_array_equal(np.stack([p.root_pos for p in poses]), batch.root_pos)

@@ -9,7 +9,7 @@ from scipy.spatial.transform import Rotation
 
 from avatar_models import quat
 from avatar_models.rigs import load_rig
-from synthesis.coolmoves import correlation, rotations
+from synthesis.coolmoves import correlation
 from synthesis.coolmoves.alignment import alignment_yaw, ramp_weights
 from synthesis.coolmoves.blend import blend_rotations, group_weights, inverse_distance_weights
 from synthesis.coolmoves.features import (
@@ -20,7 +20,6 @@ from synthesis.coolmoves.features import (
 )
 from synthesis.coolmoves.knn import KNNMatcher
 from synthesis.coolmoves.limits import JointLimits
-from synthesis.coolmoves.rotations import euler_axes, from_euler, to_euler
 from synthesis.coolmoves.smoothing import ewma, ewma_step
 from tests.synthesis.conftest import yaw_matrix
 
@@ -217,14 +216,3 @@ def test_joint_limits_clamp_knee_and_keep_legal_poses():
     out = limits.clamp(rot)
     assert np.degrees(quat.angle(out[0, knee])) == pytest.approx(140.0)
     np.testing.assert_allclose(out[1], rot[1])
-
-
-@pytest.mark.parametrize("order", ["XYZ", "YXZ", "ZXY", "XZY", "YZX", "ZYX"])
-def test_numpy_euler_matches_scipy(order):
-    rots = Rotation.random(200, random_state=11)
-    q = quat.from_scipy(rots)[:, None]  # (200, 1, 4): one joint
-    axes = euler_axes(order)
-    np.testing.assert_allclose(to_euler(q, axes)[:, 0], rots.as_euler(order), atol=1e-9)
-    np.testing.assert_allclose(rotations.to_matrix(q)[:, 0], rots.as_matrix(), atol=1e-12)
-    back = from_euler(to_euler(q, axes), axes)[:, 0]
-    np.testing.assert_allclose(np.abs(np.sum(back * q[:, 0], axis=-1)), 1.0, atol=1e-12)

@@ -11,7 +11,7 @@ from avatar_models.generator import Subject, generate
 from avatar_models.measure import standing_height
 from avatar_models.rigs import body17_positions
 from render_cams import VRSetup
-from synthesis.base import SynthesisError, TrackingFrame
+from synthesis.base import SynthesisError
 from synthesis.ik_baseline import IKBaseline, Stepper
 
 TRACKED = body17.group_indices(("head", "l_wrist", "r_wrist"))
@@ -81,14 +81,6 @@ def test_dropouts_and_nan_hold_finite(dribble):
     out = IKBaseline(motion.skeleton).run(stream.replace(positions=positions, valid=valid))
     assert out.n_frames == motion.n_frames
     assert np.isfinite(out.local_rot).all() and np.isfinite(out.root_pos).all()
-
-
-def test_step_matches_run(dribble, dribble_output):
-    motion, stream = dribble
-    ik = IKBaseline(motion.skeleton, standing_height(motion))
-    ik.reset()
-    poses = [ik.step(TrackingFrame.from_stream(stream, i)) for i in range(5)]
-    assert np.allclose(np.stack([p.root_pos for p in poses]), dribble_output.root_pos[:5])
 
 
 def test_missing_devices_are_a_clear_error(dribble):
