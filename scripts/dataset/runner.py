@@ -148,18 +148,22 @@ def generate(
             if on_shard is not None:
                 on_shard(len(shard.samples))
     else:
-        with ProcessPoolExecutor(
+        pool = ProcessPoolExecutor(
             max_workers=workers,
             mp_context=get_context("spawn"),
             initializer=_watch_parent,
             initargs=(os.getpid(),),
-        ) as pool:
-            futures = {pool.submit(write_shard, root, config, s): s for s in todo}
+        )
+        try:
+            futures = [pool.submit(write_shard, root, config, s) for s in todo]
             for future in as_completed(futures):
                 sidecar = future.result()
                 sidecars[sidecar["name"]] = sidecar
                 if on_shard is not None:
                     on_shard(sidecar["samples"])
+        finally:
+            # On an error or SIGTERM: finish the shards being written, start no others.
+            pool.shutdown(wait=True, cancel_futures=True)
     manifest = build_manifest(config, [sidecars[s.name] for s in shards])
     write_manifest(root, manifest)
     return GenerateResult(
