@@ -127,7 +127,9 @@ def register(app: typer.Typer) -> None:
         for col in ("split", "shards", "samples", "frames", "groups"):
             table.add_column(col)
         for split, c in manifest["counts"].items():
-            table.add_row(split, *(str(c[k]) for k in ("shards", "samples", "frames")), str(len(c["groups"])))
+            table.add_row(
+                split, *(str(c[k]) for k in ("shards", "samples", "frames")), str(len(c["groups"]))
+            )
         console.print(table)
         console.print(escape(f"config hash {manifest['config_hash']}"))
         emit_json(json_out, {k: v for k, v in manifest.items() if k != "shards"})

@@ -91,7 +91,9 @@ class DatasetConfig:
     seed: int = 0
     samples_per_shard: int = 64
     window: WindowConfig = field(default_factory=WindowConfig)
-    splits: dict[str, float] = field(default_factory=lambda: dict(zip(SPLITS, (0.8, 0.1, 0.1))))
+    splits: dict[str, float] = field(
+        default_factory=lambda: dict(zip(SPLITS, (0.8, 0.1, 0.1), strict=True))
+    )
     sources: tuple[SourceConfig, ...] = ()
     devices: tuple[DeviceSetConfig, ...] = ()
 

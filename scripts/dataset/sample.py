@@ -45,7 +45,9 @@ def package_version() -> str:
 def channel_seeds(seed: int) -> dict[str, int]:
     """The random channels' seeds from the sample's devices seed (module docstring)."""
     streams = np.random.SeedSequence(seed).spawn(2)
-    return {name: int(s.generate_state(1)[0]) for name, s in zip(("vr", "kinect"), streams)}
+    return {
+        name: int(s.generate_state(1)[0]) for name, s in zip(("vr", "kinect"), streams, strict=True)
+    }
 
 
 def make_sample(
@@ -69,7 +71,9 @@ def make_sample(
         arrays_fisheye, channels["fisheye"] = fisheye_channel(humanoid)
         arrays |= arrays_fisheye
     if devices.kinect != "none":
-        arrays_kinect, channels["kinect"] = kinect_channel(humanoid, devices.kinect, seeds["kinect"])
+        arrays_kinect, channels["kinect"] = kinect_channel(
+            humanoid, devices.kinect, seeds["kinect"]
+        )
         arrays |= arrays_kinect
     if devices.physics:
         arrays_physics, channels["physics"] = physics_channel(humanoid)

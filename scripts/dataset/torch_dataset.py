@@ -64,7 +64,9 @@ class ShardDataset(IterableDataset):
     def __iter__(self) -> Iterator[dict[str, Any]]:
         info = get_worker_info()
         rng = np.random.default_rng([self.seed, self.epoch, 0 if info is None else info.id])
-        samples = (as_torch(key, sample) for p in self.worker_shards() for key, sample in read_samples(p))
+        samples = (
+            as_torch(key, sample) for p in self.worker_shards() for key, sample in read_samples(p)
+        )
         if not self.shuffle_buffer:
             yield from samples
             return

@@ -25,4 +25,6 @@ def write_config(path: Path, **changes) -> Path:
 
 def tree_bytes(root: Path) -> dict[str, bytes]:
     """Every file below ``root`` by relative path, with its bytes."""
-    return {str(p.relative_to(root)): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
+    return {
+        str(p.relative_to(root)): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()
+    }

@@ -64,7 +64,17 @@ def test_mocap_source_errors(tmp_path):
 @pytest.mark.mocap
 def test_mocap_split_by_performer_keeps_performers_whole(mocap_dir):
     config = from_dict(
-        {**TINY, "sources": [{"kind": "mocap", "path": str(mocap_dir / "cmu"), "split_by": "performer", "windows": 2}]}
+        {
+            **TINY,
+            "sources": [
+                {
+                    "kind": "mocap",
+                    "path": str(mocap_dir / "cmu"),
+                    "split_by": "performer",
+                    "windows": 2,
+                }
+            ],
+        }
     )
     samples = plan_samples(config)
     assert len(samples) == 9 * 2  # CLIPS.md: 9 CMU clips

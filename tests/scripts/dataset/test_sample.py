@@ -59,7 +59,12 @@ def test_provenance(first_sample):
 @pytest.mark.mocap
 def test_real_clip_sample(mocap_dir):
     config = from_dict(
-        {**TINY, "sources": [{"kind": "mocap", "path": str(mocap_dir / "cmu"), "activities": ["running"]}]}
+        {
+            **TINY,
+            "sources": [
+                {"kind": "mocap", "path": str(mocap_dir / "cmu"), "activities": ["running"]}
+            ],
+        }
     )
     spec = plan_samples(config)[0]
     arrays, meta = make_sample(config, spec, config_hash(config))

@@ -11,7 +11,11 @@ from scripts.dataset.shards import read_samples, shard_bytes
 def _samples():
     rng = np.random.default_rng(0)
     return [
-        (f"s{k:07d}", {"b": rng.normal(size=(3, 2)).astype(np.float32), "a": np.arange(k + 1)}, {"k": k, "z": [1.5]})
+        (
+            f"s{k:07d}",
+            {"b": rng.normal(size=(3, 2)).astype(np.float32), "a": np.arange(k + 1)},
+            {"k": k, "z": [1.5]},
+        )
         for k in range(3)
     ]
 
@@ -29,7 +33,7 @@ def test_same_samples_same_bytes_in_webdataset_layout(tmp_path):
     path.write_bytes(data)
     read = list(read_samples(path))
     assert [k for k, _ in read] == ["s0000000", "s0000001", "s0000002"]
-    for (key, arrays, meta), (_, sample) in zip(_samples(), read, strict=True):
+    for (_, arrays, meta), (_, sample) in zip(_samples(), read, strict=True):
         assert sample["json"] == meta
         for name, value in arrays.items():
             assert sample[name].dtype == value.dtype

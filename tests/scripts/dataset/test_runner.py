@@ -1,0 +1,98 @@
+from __future__ import annotations
+
+import os
+import random
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from scripts.dataset.config import load_config
+from scripts.dataset.manifest import DatasetError
+from scripts.dataset.runner import generate
+from scripts.dataset.verify import verify_dataset
+from tests.scripts.dataset.builders import tree_bytes
+
+REPO = Path(__file__).resolve().parents[3]
+
+
+def test_two_workers_write_the_same_bytes_as_one(tiny_dataset, tiny_config_path, tmp_path):
+    result = generate(load_config(tiny_config_path), tmp_path / "ds", workers=2)
+    assert result.made == result.shards == 5
+    assert tree_bytes(tmp_path / "ds") == tree_bytes(tiny_dataset)
+
+
+def test_resume_remakes_only_what_is_missing_or_wrong(tiny_dataset, tiny_config_path, tmp_path):
+    root = tmp_path / "ds"
+    root.mkdir()
+    for name, data in tree_bytes(tiny_dataset).items():
+        (root / name).parent.mkdir(parents=True, exist_ok=True)
+        (root / name).write_bytes(data)
+    (root / "manifest.json").unlink()
+    (root / "shards" / "train-000001.tar").unlink()  # lost
+    (root / "shards" / "val-000000.tar").write_bytes(b"half a shard")  # torn
+    (root / "shards" / ".test-000000.tar.abc.tmp").write_bytes(b"left by a kill")
+    result = generate(load_config(tiny_config_path), root, workers=1)
+    assert result.made == 2
+    assert tree_bytes(root) == tree_bytes(tiny_dataset)
+
+
+def test_foreign_or_other_config_folders_are_refused(tiny_dataset, tiny_config_path, tmp_path):
+    before = tree_bytes(tiny_dataset)
+    with pytest.raises(DatasetError, match="another config or seed"):
+        generate(load_config(tiny_config_path).with_seed(4), tiny_dataset)
+    assert tree_bytes(tiny_dataset) == before
+    (tmp_path / "notes.txt").write_text("mine")
+    with pytest.raises(DatasetError, match="holds no dataset"):
+        generate(load_config(tiny_config_path), tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]
+
+
+def _generate_cmd(config: Path, out: Path) -> list[str]:
+    return [
+        sys.executable,
+        "-m",
+        "scripts.cli",
+        "dataset",
+        "generate",
+        str(config),
+        "--out",
+        str(out),
+    ]
+
+
+@pytest.mark.parametrize("kills", [3, pytest.param(20, marks=pytest.mark.slow)])
+def test_kill_9_at_random_moments_then_resume_is_byte_identical(
+    tiny_dataset, tiny_config_path, tmp_path, kills
+):
+    """``kill -9`` the generator ``kills`` times, each at a random moment once it has started
+    writing (or earlier), then let it finish: the same bytes as an uninterrupted run."""
+    rng = random.Random(kills)
+    out = tmp_path / "ds"
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    shards_seen = []
+    for _ in range(kills):
+        proc = subprocess.Popen(
+            _generate_cmd(tiny_config_path, out),
+            cwd=REPO,
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        deadline = time.monotonic() + 120
+        while not (out / "dataset.json").exists() and proc.poll() is None:
+            assert time.monotonic() < deadline
+            time.sleep(0.05)
+        time.sleep(rng.uniform(0.0, 3.0))
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()
+        shards_seen.append(len(list((out / "shards").glob("*.tar"))))
+    done = subprocess.run(
+        _generate_cmd(tiny_config_path, out), cwd=REPO, env=env, capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    assert tree_bytes(out) == tree_bytes(tiny_dataset), shards_seen
+    assert verify_dataset(out).passed
