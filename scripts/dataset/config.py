@@ -49,7 +49,8 @@ class SourceConfig:
         activities: activities to use (builtin: default all; mocap: a filter, default all).
         subjects: builtin: number of sampled subjects.
         windows: windows per subject x activity (builtin) or per clip (mocap).
-        path: mocap: the folder.
+        path: mocap: the folder (relative to the config file's folder when read by
+            :func:`load_config`).
         split_by: mocap: ``"clip"`` or ``"performer"`` (the library's subject label).
     """
 
@@ -126,9 +127,17 @@ def load_config(path: str | Path) -> DatasetConfig:
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise ConfigError(f"{path}: not valid TOML: {exc}") from None
     try:
-        return from_dict(data)
+        config = from_dict(data)
     except ConfigError as exc:
         raise ConfigError(f"{path}: {exc}") from None
+    # A relative mocap folder is relative to the config file, as a scenario's motion path is.
+    sources = tuple(
+        replace(s, path=str(path.parent / s.path))
+        if s.path and not Path(s.path).is_absolute()
+        else s
+        for s in config.sources
+    )
+    return replace(config, sources=sources)
 
 
 def from_dict(data: dict[str, Any]) -> DatasetConfig:

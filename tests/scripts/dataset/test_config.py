@@ -43,3 +43,9 @@ def test_unreadable_and_invalid_toml(tmp_path):
         load_config(bad)
     with pytest.raises(ConfigError, match="needs a name"):
         from_dict({k: v for k, v in TINY.items() if k != "name"})
+
+
+def test_relative_mocap_folders_are_relative_to_the_config(tmp_path):
+    sources = [{"kind": "mocap", "path": "clips"}, {"kind": "mocap", "path": "/abs/clips"}]
+    config = load_config(write_config(tmp_path / "c.toml", sources=sources))
+    assert [s.path for s in config.sources] == [str(tmp_path / "clips"), "/abs/clips"]

@@ -14,7 +14,7 @@ from scripts.dataset.config import load_config
 from scripts.dataset.manifest import DatasetError
 from scripts.dataset.runner import generate
 from scripts.dataset.verify import verify_dataset
-from tests.scripts.dataset.builders import tree_bytes
+from tests.scripts.dataset.builders import tree_bytes, write_config
 
 REPO = Path(__file__).resolve().parents[3]
 
@@ -96,3 +96,19 @@ def test_kill_9_at_random_moments_then_resume_is_byte_identical(
     assert done.returncode == 0, done.stderr
     assert tree_bytes(out) == tree_bytes(tiny_dataset), shards_seen
     assert verify_dataset(out).passed
+
+
+@pytest.mark.mocap
+def test_a_mocap_dataset_split_by_clip_verifies(mocap_dir, tmp_path):
+    source = {"kind": "mocap", "path": str(mocap_dir / "cmu"), "activities": ["running"]}
+    config = load_config(write_config(tmp_path / "c.toml", sources=[source]))
+    result = generate(config, tmp_path / "ds")
+    counts = result.manifest["counts"]
+    assert result.samples == 3  # CLIPS.md: 3 running clips
+    train, held_out = (
+        set(counts["train"]["groups"]),
+        {*counts["val"]["groups"], *counts["test"]["groups"]},
+    )
+    assert held_out and not train & held_out
+    assert all(g.startswith("clip:") for g in train | held_out)
+    assert verify_dataset(tmp_path / "ds").passed
