@@ -26,6 +26,7 @@ from rich.table import Table
 
 from scripts.cli_common import (
     JsonOpt,
+    SeedOpt,
     check_outputs,
     console,
     emit_json,
@@ -117,7 +118,7 @@ def register(app: typer.Typer) -> None:
 
     @dataset.command()
     @user_errors
-    def info(path: DirArg, json_out: JsonOpt = None) -> None:
+    def info(path: DirArg, seed: SeedOpt = 0, json_out: JsonOpt = None) -> None:
         """Counts per split, frames, shards and the config of a dataset."""
         from scripts.dataset.manifest import read_manifest
 
@@ -132,11 +133,13 @@ def register(app: typer.Typer) -> None:
             )
         console.print(table)
         console.print(escape(f"config hash {manifest['config_hash']}"))
-        emit_json(json_out, {k: v for k, v in manifest.items() if k != "shards"})
+        # Nothing here is random; the seed is accepted and recorded as every command's is.
+        payload = {k: v for k, v in manifest.items() if k != "shards"}
+        emit_json(json_out, payload | {"shards": len(manifest["shards"]), "seed": seed})
 
     @dataset.command()
     @user_errors
-    def verify(path: DirArg, json_out: JsonOpt = None) -> None:
+    def verify(path: DirArg, seed: SeedOpt = 0, json_out: JsonOpt = None) -> None:
         """Check shard hashes, counts, that nothing is lost or duplicated, and that no
         held-out subject or clip reaches train. Exit 1 when a check fails."""
         from scripts.dataset.verify import verify_dataset
@@ -158,6 +161,7 @@ def register(app: typer.Typer) -> None:
                 "shards": report.shards,
                 "samples": report.samples,
                 "frames": report.frames,
+                "seed": seed,  # nothing is random; recorded as every command's is
             },
         )
         if not report.passed:
