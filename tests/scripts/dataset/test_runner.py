@@ -14,7 +14,7 @@ from scripts.dataset.config import load_config
 from scripts.dataset.manifest import DatasetError
 from scripts.dataset.runner import generate
 from scripts.dataset.verify import verify_dataset
-from tests.scripts.dataset.builders import tree_bytes, write_config
+from tests.scripts.dataset.builders import TINY, tree_bytes, write_config
 
 REPO = Path(__file__).resolve().parents[3]
 
@@ -64,38 +64,56 @@ def _generate_cmd(config: Path, out: Path) -> list[str]:
     ]
 
 
-@pytest.mark.parametrize("kills", [3, pytest.param(20, marks=pytest.mark.slow)])
+# 20 kills get a dataset of 20 one-sample shards, so that most of them land mid-run.
+MANY_SHARDS = {"samples_per_shard": 1, "sources": [{**TINY["sources"][0], "subjects": 10}]}
+
+
+@pytest.mark.parametrize(
+    "kills, changes", [(3, {}), pytest.param(20, MANY_SHARDS, marks=pytest.mark.slow)]
+)
 def test_kill_9_at_random_moments_then_resume_is_byte_identical(
-    tiny_dataset, tiny_config_path, tmp_path, kills
+    tiny_dataset, tmp_path, kills, changes
 ):
-    """``kill -9`` the generator ``kills`` times, each at a random moment once it has started
-    writing (or earlier), then let it finish: the same bytes as an uninterrupted run."""
+    """``kill -9`` the generator ``kills`` times, each at a random moment while it works
+    (its start-up, measured on the first run, plus up to 1.5 s), then let it finish: the
+    same bytes as an uninterrupted run, and ``verify`` passes."""
+    config_path = write_config(tmp_path / "c.toml", **changes)
+    expected = tiny_dataset
+    if changes:
+        expected = tmp_path / "expected"
+        generate(load_config(config_path), expected)
+    n_shards = len(list((expected / "shards").glob("*.tar")))
     rng = random.Random(kills)
     out = tmp_path / "ds"
     env = {**os.environ, "PYTHONPATH": str(REPO)}
+    startup = None
     shards_seen = []
     for _ in range(kills):
+        begun = time.monotonic()
         proc = subprocess.Popen(
-            _generate_cmd(tiny_config_path, out),
+            _generate_cmd(config_path, out),
             cwd=REPO,
             env=env,
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
         )
-        deadline = time.monotonic() + 120
-        while not (out / "dataset.json").exists() and proc.poll() is None:
-            assert time.monotonic() < deadline
-            time.sleep(0.05)
-        time.sleep(rng.uniform(0.0, 3.0))
+        if startup is None:  # until the first run has planned and written dataset.json
+            while not (out / "dataset.json").exists() and proc.poll() is None:
+                assert time.monotonic() - begun < 120
+                time.sleep(0.02)
+            startup = time.monotonic() - begun
+        time.sleep(max(0.0, startup - (time.monotonic() - begun)) + rng.uniform(0.0, 1.5))
         proc.send_signal(signal.SIGKILL)
         proc.wait()
         shards_seen.append(len(list((out / "shards").glob("*.tar"))))
+    assert any(0 < n < n_shards for n in shards_seen), shards_seen  # some kills cut the work short
     done = subprocess.run(
-        _generate_cmd(tiny_config_path, out), cwd=REPO, env=env, capture_output=True, text=True
+        _generate_cmd(config_path, out), cwd=REPO, env=env, capture_output=True, text=True
     )
     assert done.returncode == 0, done.stderr
-    assert tree_bytes(out) == tree_bytes(tiny_dataset), shards_seen
+    assert tree_bytes(out) == tree_bytes(expected), shards_seen
     assert verify_dataset(out).passed
+    print(f"shards written at each of the {kills} kills: {shards_seen}")
 
 
 @pytest.mark.mocap
