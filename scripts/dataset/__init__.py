@@ -1,0 +1,15 @@
+"""Synthetic datasets: ``avatarsim dataset generate|info|verify`` (issue 11, first slice).
+
+One concept per module:
+
+- :mod:`.config`: the TOML schema (:func:`load_config`, :class:`ConfigError`);
+- :mod:`.plan`: the deterministic list of samples and their shards;
+- :mod:`.motion_source`: the motion window of one planned sample;
+- :mod:`.channels`: what a sample records, one function per device or label set;
+- :mod:`.sample`: one sample's arrays and JSON (ground truth plus its channels);
+- :mod:`.shards`: WebDataset-layout tar shards, byte-deterministic;
+- :mod:`.manifest`: per-shard sidecars and the dataset manifest;
+- :mod:`.runner`: the local process pool, atomic shard writes, resume, progress;
+- :mod:`.verify`: hashes, counts, nothing lost or duplicated, no split leak;
+- :mod:`.torch_dataset`: a torch ``IterableDataset`` over the shards.
+"""

@@ -1,0 +1,126 @@
+"""What a sample records of its window, one function per channel: each returns its arrays
+(float32 for real values: training data, ~1e-7 relative error, half the size) and the JSON
+that describes them. All take the window's humanoid (:func:`sim.humanoid.humanoid_for`),
+whose motion and body every channel shares, and a channel seed.
+
+- :func:`vr_channel`: headset + controllers (+ trackers) at 90 Hz with the validity mask.
+- :func:`fisheye_channel`: the controller cameras' body17 keypoints, *projected*: the
+  cameras' poses and lens model are the :class:`render_cams.fisheye.device.FisheyeRig`'s,
+  but no image is rendered, so ``in_view`` means "in the image and the lens not inside the
+  body" and is NOT occlusion-tested (a joint behind the user's own arm counts as in view);
+  the rendered visibility of :func:`render_cams.fisheye.keypoints.visibility` needs a range
+  image per frame (images are a later slice). Confidences are
+  :func:`render_cams.fisheye.keypoints.confidence` of that ``in_view``.
+- :func:`kinect_channel`: the Kinect skeleton with tracking states (no depth is rendered).
+- :func:`physics_channel`: per-frame foot contact, floor penetration and foot skate from
+  :func:`sim.plausibility.check_humanoid`.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from avatar_models.rigs import body17_positions
+from render_cams.device import motion_at_rate
+from render_cams.fisheye.device import FisheyeRig
+from render_cams.fisheye.keypoints import confidence, project_joints, world_to_camera
+from render_cams.fisheye.rig import camera_poses, controller_cameras, inside_body
+from render_cams.kinect import Kinect
+from render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
+from scripts.dataset.config import DeviceSetConfig
+from scripts.stages.devices import REALISTIC_NOISE
+from sim.humanoid import Humanoid
+from sim.plausibility import check_humanoid
+
+Channel = tuple[dict[str, np.ndarray], dict[str, Any]]
+CM = 0.01  # the checks report centimetres; datasets store metres
+
+
+def f32(values: np.ndarray) -> np.ndarray:
+    return np.ascontiguousarray(values, dtype=np.float32)
+
+
+def vr_channel(humanoid: Humanoid, devices: DeviceSetConfig, seed: int) -> Channel:
+    """``vr_time`` (Tv,), ``vr_pos`` (Tv, D, 3), ``vr_quat`` (Tv, D, 4) wxyz, ``vr_valid``
+    (Tv, D) bool."""
+    setup = VRSetup(
+        devices=FULL_BODY if devices.trackers else HEADSET_AND_CONTROLLERS,
+        noise=REALISTIC_NOISE if devices.vr_noise == "realistic" else (),
+    )
+    stream = setup.sample(humanoid.motion, seed=seed)
+    arrays = {
+        "vr_time": f32(stream.timestamps),
+        "vr_pos": f32(stream.positions),
+        "vr_quat": f32(stream.quaternions),
+        "vr_valid": np.ascontiguousarray(stream.valid, dtype=bool),
+    }
+    meta = {
+        "rate_hz": setup.rate_hz,
+        "devices": list(stream.device_names),
+        "noise": devices.vr_noise,
+        "seed": seed,
+    }
+    return arrays, meta
+
+
+def fisheye_channel(humanoid: Humanoid) -> Channel:
+    """``fisheye_uv`` (Tc, C, 17, 2) pixels, ``fisheye_conf`` (Tc, C, 17), ``fisheye_in_view``
+    (Tc, C, 17) bool, ``fisheye_lens_covered`` (Tc, C) bool, ``fisheye_w2c`` (Tc, C, 4, 4)
+    world-to-camera (OpenCV axes); intrinsics in the JSON. Projected, not rendered, and
+    exact (module docstring): no detector noise yet, so nothing random."""
+    rig = FisheyeRig()
+    sampled = motion_at_rate(humanoid.motion, rig.rate_hz)
+    cameras = controller_cameras(rig.controllers, rig.mount)
+    poses = camera_poses(sampled, cameras)  # (Tc, C, 4, 4)
+    covered = inside_body(humanoid.body, *sampled.fk(), poses[..., :3, 3])  # (Tc, C)
+    joints = body17_positions(sampled)  # (Tc, 17, 3)
+    n_frames, n_cams = poses.shape[:2]
+    uv, in_image, _ = project_joints(
+        rig.model, poses.reshape(-1, 4, 4), np.repeat(joints, n_cams, axis=0)
+    )
+    uv = uv.reshape(n_frames, n_cams, -1, 2)
+    in_view = in_image.reshape(n_frames, n_cams, -1) & ~covered[..., None]
+    arrays = {
+        "fisheye_uv": f32(uv),
+        "fisheye_conf": f32(confidence(rig.model, uv, in_view)),
+        "fisheye_in_view": in_view,
+        "fisheye_lens_covered": np.ascontiguousarray(covered, dtype=bool),
+        "fisheye_w2c": f32(world_to_camera(poses)),
+    }
+    meta = {
+        "rate_hz": rig.rate_hz,
+        "cameras": [c.name for c in cameras],
+        "model": rig.model.as_dict(),
+        "keypoints": "projected (in_view not occlusion-tested; no images rendered)",
+    }
+    return arrays, meta
+
+
+def kinect_channel(humanoid: Humanoid, sensor: str, seed: int) -> Channel:
+    """``kinect_pos`` (Tk, J, 3) world metres (meaningless where not tracked),
+    ``kinect_quat`` (Tk, J, 4) wxyz, ``kinect_state`` (Tk, J) int8 (0 not tracked,
+    1 inferred, 2 tracked); sensor intrinsics and pose in the JSON."""
+    recording = Kinect(sensor).sample(humanoid.motion, seed=seed, body=humanoid.body)
+    skeleton = recording.skeleton
+    arrays = {
+        "kinect_pos": f32(skeleton.positions),
+        "kinect_quat": f32(skeleton.orientations),
+        "kinect_state": np.ascontiguousarray(skeleton.states, dtype=np.int8),
+    }
+    return arrays, recording.record
+
+
+def physics_channel(humanoid: Humanoid) -> Channel:
+    """``contact`` (T, 2) bool (left, right foot), ``penetration_m`` (T,), ``skate_m_s``
+    (T, 2) (left, right), at the window's frames."""
+    columns = check_humanoid(humanoid).per_frame()
+    arrays = {
+        "contact": np.stack([columns["contact_left"], columns["contact_right"]], 1) > 0,
+        "penetration_m": f32(columns["penetration_cm"] * CM),
+        "skate_m_s": f32(
+            np.stack([columns["skate_left_cm_s"], columns["skate_right_cm_s"]], 1) * CM
+        ),
+    }
+    return arrays, {"source": "sim.plausibility.check_humanoid", "units": "m, m/s"}

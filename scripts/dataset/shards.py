@@ -1,0 +1,88 @@
+"""WebDataset-layout tar shards, byte-deterministic.
+
+A shard is a plain POSIX (ustar) tar: each sample's entries ``<key>.<name>.npy`` (one per
+array, ``numpy.save`` format) then ``<key>.json``, samples in plan order, entries of a sample
+sorted by name. WebDataset groups consecutive entries by the key before the first dot, so
+``webdataset.WebDataset(url)`` reads these shards as they are. Every header field that could
+vary between runs is fixed (mtime 0, uid/gid 0, no user or group name, mode 0644), and the
+JSON is written with sorted keys, so the same samples always give the same bytes.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import tarfile
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from avatar_models.fileio import json_safe
+
+SampleEntries = tuple[str, dict[str, np.ndarray], dict[str, Any]]
+
+
+def _add(tar: tarfile.TarFile, name: str, data: bytes) -> None:
+    info = tarfile.TarInfo(name)
+    info.size = len(data)
+    info.mtime = 0
+    info.mode = 0o644
+    info.uid = info.gid = 0
+    info.uname = info.gname = ""
+    tar.addfile(info, io.BytesIO(data))
+
+
+def npy_bytes(array: np.ndarray) -> bytes:
+    buffer = io.BytesIO()
+    np.save(buffer, np.ascontiguousarray(array), allow_pickle=False)
+    return buffer.getvalue()
+
+
+def json_bytes(meta: dict[str, Any]) -> bytes:
+    text = json.dumps(json_safe(meta), sort_keys=True, allow_nan=False, separators=(",", ":"))
+    return text.encode()
+
+
+def shard_bytes(samples: list[SampleEntries]) -> bytes:
+    """The tar of ``samples`` (``(key, arrays, meta)`` each), as bytes (module docstring)."""
+    buffer = io.BytesIO()
+    with tarfile.open(fileobj=buffer, mode="w", format=tarfile.USTAR_FORMAT) as tar:
+        for key, arrays, meta in samples:
+            for name in sorted(arrays):
+                _add(tar, f"{key}.{name}.npy", npy_bytes(arrays[name]))
+            _add(tar, f"{key}.json", json_bytes(meta))
+    return buffer.getvalue()
+
+
+def sha256_file(path: Path) -> str:
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def read_samples(path: Path) -> Iterator[tuple[str, dict[str, Any]]]:
+    """The samples of a shard in order: ``(key, {"json": dict, name: array...})``.
+
+    Raises:
+        tarfile.TarError: not a tar (a truncated or foreign file).
+    """
+    with tarfile.open(path, mode="r:") as tar:
+        key, sample = None, {}
+        for member in tar:
+            stem, _, ext = member.name.partition(".")
+            if key is not None and stem != key:
+                yield key, sample
+                sample = {}
+            key = stem
+            data = tar.extractfile(member).read()
+            if ext == "json":
+                sample["json"] = json.loads(data)
+            else:
+                sample[ext.removesuffix(".npy")] = np.load(io.BytesIO(data), allow_pickle=False)
+        if key is not None:
+            yield key, sample

@@ -1,0 +1,51 @@
+from __future__ import annotations
+
+import pytest
+
+from scripts.dataset.config import ConfigError, config_hash, from_dict, load_config
+from tests.scripts.dataset.builders import TINY, write_config
+
+
+def test_tiny_config_loads_with_defaults(tmp_path):
+    config = load_config(write_config(tmp_path / "c.toml"))
+    assert config.devices[0].vr and config.devices[0].fisheye  # defaults
+    assert config.sources[0].windows == 1
+    assert config.with_seed(9).seed == 9 and config_hash(config.with_seed(9)) != config_hash(config)
+    assert from_dict(config.as_dict()) == config  # a manifest's copy reads back the same
+
+
+@pytest.mark.parametrize(
+    "changes, reason",
+    [
+        ({"colour": "red"}, "unknown key 'colour'"),
+        ({"window": {"seconds": 1.0, "fsp": 30}}, "unknown key 'fsp'"),
+        ({"sources": [{"kind": "builtin", "subjects": 2, "speed": 1}]}, "unknown key 'speed'"),
+        ({"sources": [{"kind": "builtin", "subjects": 0}]}, "empty source"),
+        ({"sources": []}, "no [[sources]]"),
+        ({"sources": [{"kind": "builtin", "activities": ["fly"], "subjects": 1}]}, "'fly'"),
+        ({"splits": {"train": 0.8, "val": 0.1, "test": 0.2}}, "sum to 1"),
+        ({"splits": {"train": 0.9, "holdout": 0.1}}, "unknown split"),
+        ({"devices": [{"name": "a", "kinect": "kinect-v3"}]}, "kinect must be"),
+        ({"samples_per_shard": 0}, "samples_per_shard"),
+    ],
+)
+def test_bad_configs_are_config_errors(tmp_path, changes, reason):
+    with pytest.raises(ConfigError, match=reason.replace("[", r"\[").replace("]", r"\]")):
+        load_config(write_config(tmp_path / "c.toml", **changes))
+
+
+def test_unreadable_and_invalid_toml(tmp_path):
+    with pytest.raises(ConfigError, match="cannot read"):
+        load_config(tmp_path / "absent.toml")
+    bad = tmp_path / "bad.toml"
+    bad.write_text("name = ")
+    with pytest.raises(ConfigError, match="not valid TOML"):
+        load_config(bad)
+    with pytest.raises(ConfigError, match="needs a name"):
+        from_dict({k: v for k, v in TINY.items() if k != "name"})
+
+
+def test_relative_mocap_folders_are_relative_to_the_config(tmp_path):
+    sources = [{"kind": "mocap", "path": "clips"}, {"kind": "mocap", "path": "/abs/clips"}]
+    config = load_config(write_config(tmp_path / "c.toml", sources=sources))
+    assert [s.path for s in config.sources] == [str(tmp_path / "clips"), "/abs/clips"]

@@ -1,0 +1,132 @@
+from __future__ import annotations
+
+import os
+import random
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from scripts.dataset.config import load_config
+from scripts.dataset.manifest import DatasetError
+from scripts.dataset.runner import generate
+from scripts.dataset.verify import verify_dataset
+from tests.scripts.dataset.builders import TINY, tree_bytes, write_config
+
+REPO = Path(__file__).resolve().parents[3]
+
+
+def test_two_workers_write_the_same_bytes_as_one(tiny_dataset, tiny_config_path, tmp_path):
+    result = generate(load_config(tiny_config_path), tmp_path / "ds", workers=2)
+    assert result.made == result.shards == 5
+    assert tree_bytes(tmp_path / "ds") == tree_bytes(tiny_dataset)
+
+
+def test_resume_remakes_only_what_is_missing_or_wrong(tiny_dataset, tiny_config_path, tmp_path):
+    root = tmp_path / "ds"
+    root.mkdir()
+    for name, data in tree_bytes(tiny_dataset).items():
+        (root / name).parent.mkdir(parents=True, exist_ok=True)
+        (root / name).write_bytes(data)
+    (root / "manifest.json").unlink()
+    (root / "shards" / "train-000001.tar").unlink()  # lost
+    (root / "shards" / "val-000000.tar").write_bytes(b"half a shard")  # torn
+    (root / "shards" / ".test-000000.tar.abc.tmp").write_bytes(b"left by a kill")
+    result = generate(load_config(tiny_config_path), root, workers=1)
+    assert result.made == 2
+    assert tree_bytes(root) == tree_bytes(tiny_dataset)
+
+
+def test_foreign_or_other_config_folders_are_refused(tiny_dataset, tiny_config_path, tmp_path):
+    before = tree_bytes(tiny_dataset)
+    with pytest.raises(DatasetError, match="another config or seed"):
+        generate(load_config(tiny_config_path).with_seed(4), tiny_dataset)
+    assert tree_bytes(tiny_dataset) == before
+    (tmp_path / "notes.txt").write_text("mine")
+    with pytest.raises(DatasetError, match="holds no dataset"):
+        generate(load_config(tiny_config_path), tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes.txt"]
+
+
+def _generate_cmd(config: Path, out: Path) -> list[str]:
+    return [
+        sys.executable,
+        "-m",
+        "scripts.cli",
+        "dataset",
+        "generate",
+        str(config),
+        "--out",
+        str(out),
+    ]
+
+
+# 20 kills get a dataset of 20 one-sample shards, so that most of them land mid-run.
+MANY_SHARDS = {"samples_per_shard": 1, "sources": [{**TINY["sources"][0], "subjects": 10}]}
+
+
+@pytest.mark.parametrize(
+    "kills, changes", [(3, {}), pytest.param(20, MANY_SHARDS, marks=pytest.mark.slow)]
+)
+def test_kill_9_at_random_moments_then_resume_is_byte_identical(
+    tiny_dataset, tmp_path, kills, changes
+):
+    """``kill -9`` the generator ``kills`` times, each at a random moment while it works
+    (its start-up, measured on the first run, plus up to 1.5 s), then let it finish: the
+    same bytes as an uninterrupted run, and ``verify`` passes."""
+    config_path = write_config(tmp_path / "c.toml", **changes)
+    expected = tiny_dataset
+    if changes:
+        expected = tmp_path / "expected"
+        generate(load_config(config_path), expected)
+    n_shards = len(list((expected / "shards").glob("*.tar")))
+    rng = random.Random(kills)
+    out = tmp_path / "ds"
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    startup = None
+    shards_seen = []
+    for _ in range(kills):
+        begun = time.monotonic()
+        proc = subprocess.Popen(
+            _generate_cmd(config_path, out),
+            cwd=REPO,
+            env=env,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        if startup is None:  # until the first run has planned and written dataset.json
+            while not (out / "dataset.json").exists() and proc.poll() is None:
+                assert time.monotonic() - begun < 120
+                time.sleep(0.02)
+            startup = time.monotonic() - begun
+        time.sleep(max(0.0, startup - (time.monotonic() - begun)) + rng.uniform(0.0, 1.5))
+        proc.send_signal(signal.SIGKILL)
+        proc.wait()
+        shards_seen.append(len(list((out / "shards").glob("*.tar"))))
+    assert any(0 < n < n_shards for n in shards_seen), shards_seen  # some kills cut the work short
+    done = subprocess.run(
+        _generate_cmd(config_path, out), cwd=REPO, env=env, capture_output=True, text=True
+    )
+    assert done.returncode == 0, done.stderr
+    assert tree_bytes(out) == tree_bytes(expected), shards_seen
+    assert verify_dataset(out).passed
+    print(f"shards written at each of the {kills} kills: {shards_seen}")
+
+
+@pytest.mark.mocap
+def test_a_mocap_dataset_split_by_clip_verifies(mocap_dir, tmp_path):
+    source = {"kind": "mocap", "path": str(mocap_dir / "cmu"), "activities": ["running"]}
+    config = load_config(write_config(tmp_path / "c.toml", sources=[source]))
+    result = generate(config, tmp_path / "ds")
+    counts = result.manifest["counts"]
+    assert result.samples == 3  # CLIPS.md: 3 running clips
+    train, held_out = (
+        set(counts["train"]["groups"]),
+        {*counts["val"]["groups"], *counts["test"]["groups"]},
+    )
+    assert held_out and not train & held_out
+    assert all(g.startswith("clip:") for g in train | held_out)
+    assert verify_dataset(tmp_path / "ds").passed
