@@ -28,7 +28,7 @@ import numpy as np
 
 from avatar_models.body17 import BODY17
 from sim.control import balance
-from sim.control.falls import fall_frame
+from sim.control.falls import fallen, first_fall
 from sim.control.model import BodyIndices, control_model
 from sim.control.qp import WholeBodyQP
 from sim.control.records import FrameRecord, Recording
@@ -193,7 +193,7 @@ class Controller:
         reference_frame, qpos, sites = c["reference_frame"], c["qpos"], c["sites"]
         ref_sites = ref.sites_at(reference_frame)
         qpos_ref = ref.frame_qpos(reference_frame)
-        fall = fall_frame(self.settings, qpos, qpos_ref, sites, ref_sites, c["unstable"])
+        fall = first_fall(fallen(self.settings, qpos, qpos_ref, sites, ref_sites, c["unstable"]))
         return ControlResult(
             qpos=qpos,
             body17_error=np.linalg.norm(sites - ref_sites, axis=-1),

@@ -52,14 +52,7 @@ def fallen(
     return low | (tilt_deg(qpos, qpos_ref) > settings.fall_tilt_deg) | unstable | lost
 
 
-def fall_frame(
-    settings: ControlSettings,
-    qpos: np.ndarray,
-    qpos_ref: np.ndarray,
-    sites: np.ndarray,
-    ref_sites: np.ndarray,
-    unstable: np.ndarray,
-) -> int | None:
-    """The first frame :func:`fallen` (same arguments), or ``None``."""
-    frames = np.flatnonzero(fallen(settings, qpos, qpos_ref, sites, ref_sites, unstable))
+def first_fall(fallen_frames: np.ndarray) -> int | None:
+    """The first frame true in ``fallen_frames (T,)`` (:func:`fallen`), or ``None``."""
+    frames = np.flatnonzero(fallen_frames)
     return int(frames[0]) if frames.size else None

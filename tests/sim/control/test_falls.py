@@ -9,7 +9,7 @@ from avatar_models.body import build_body
 from avatar_models.body.ik import humanoid_model
 from avatar_models.rigs import load_rig
 from sim.control.controller import control
-from sim.control.falls import HEAD, fall_frame, fallen, tilt_deg
+from sim.control.falls import HEAD, fallen, first_fall, tilt_deg
 from sim.control.settings import ControlSettings
 
 UPRIGHT = np.array([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0])
@@ -32,15 +32,10 @@ def test_each_criterion_alone_is_a_fall():
     qpos[2, 3:7] = lying
     sites[3] += [0.6, 0.0, 0.0]  # everything 0.6 m away: lost
     unstable[4] = True
-    assert fallen(settings, qpos, qpos_ref, sites, ref_sites, unstable).tolist() == [
-        False,
-        True,
-        True,
-        True,
-        True,
-    ]
+    frames = fallen(settings, qpos, qpos_ref, sites, ref_sites, unstable)
+    assert frames.tolist() == [False, True, True, True, True]
     np.testing.assert_allclose(tilt_deg(qpos[2:3], qpos_ref[2:3]), [90.0])
-    assert fall_frame(settings, qpos, qpos_ref, sites, ref_sites, unstable) == 1
+    assert first_fall(frames) == 1 and first_fall(np.zeros(3, bool)) is None
 
 
 def test_a_body_left_behind_by_its_reference_is_lost():
