@@ -29,7 +29,7 @@ def run(ctx: RunContext) -> None:
     if spec is None:
         return
     fps = ctx.motion.fps
-    reference = ctx.humanoid.for_tracking()
+    reference = ctx.humanoid.for_control()
     qpos = looped(reference.qpos, fps, spec.seconds)
     search = SearchSettings() if spec.search else None
     result, summary = timed_control(reference.model, qpos, fps, search)
