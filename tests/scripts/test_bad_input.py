@@ -142,7 +142,7 @@ def test_control_replaces_its_own_output_but_not_a_file_added_to_it(tmp_path, cl
     bad(args, "keep.txt")
     assert (out / "keep.txt").read_text() == "mine"
     # Another command's output is not control's to replace either.
-    bad(["run", str(tmp_path / "none.toml"), "--out", str(out)], "keep.txt")
+    bad(["run", str(tmp_path / "none.toml"), "--out", str(out)], "output of `avatarsim control`")
     no_partials(tmp_path)
 
 
