@@ -29,6 +29,7 @@ from scripts.cli_common import (
     console,
     emit_json,
     err_console,
+    export_viewer,
     load_motion_arg,
     user_errors,
 )
@@ -130,15 +131,7 @@ def register(app: typer.Typer) -> None:
             written = write_outputs(result, summary, partial, f"physics control: {motion}")
         console.print(escape(f"wrote {', '.join(str(out / p.name) for p in written.values())}"))
         if export is not None:
-            from sim.export import export_replay
-
-            export_replay(humanoid, result.qpos, m.fps, export)
-            console.print(
-                escape(
-                    f"MuJoCo viewer files in {export}/ (python -m mujoco.viewer --mjcf "
-                    f"{export}/replay.xml)"
-                )
-            )
+            export_viewer(humanoid, result.qpos, m.fps, export)
         emit_json(json_out, summary)
         if not summary["completed"]:
             upright_s = summary["duration_s"] if not result.fell else result.fall_time_s
