@@ -6,7 +6,7 @@ Shapes: ``nq``/``nu`` MuJoCo sizes, 17 body17 sites.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -64,5 +64,5 @@ class Recording:
         (T, nq)``, ``sites (T, 17, 3)``, ``torque (T, nu)``, ``power (T,)``, ``unstable
         (T,)``."""
         records = self.records()
-        names = FrameRecord.__dataclass_fields__
+        names = [field.name for field in fields(FrameRecord)]
         return {name: np.array([getattr(r, name) for r in records]) for name in names}
