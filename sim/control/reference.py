@@ -28,21 +28,21 @@ class ReferencePoint:
     Attributes:
         frame: the frame played, within ``[0, T - 1]``.
         qpos: ``(nq,)`` configuration, interpolated on the manifold (``mj_integratePos``).
-        frame_qpos: ``(nq,)`` configuration of the nearest frame (falls are judged on it).
         qvel, qacc: ``(nv,)`` velocity and acceleration.
         swing: ``(2,)`` foot-placement weights (:func:`sim.control.balance.swing_weights`).
         com: ``(3, 3)`` whole-body centre of mass position, velocity, acceleration.
-        sites: ``(17, 3)`` body17 site positions.
+
+    The nearest frame's configuration (falls are judged on it) is
+    :meth:`Reference.frame_qpos` of ``frame``, the body17 sites :meth:`Reference.sites_at`:
+    only the search's cost reads them.
     """
 
     frame: float
     qpos: np.ndarray
-    frame_qpos: np.ndarray
     qvel: np.ndarray
     qacc: np.ndarray
     swing: np.ndarray
     com: np.ndarray
-    sites: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -120,17 +120,15 @@ class Reference:
         return ReferencePoint(
             frame=frame,
             qpos=qpos,
-            frame_qpos=self.frame_qpos(frame),
             qvel=_blend(self.qvel, i, a),
             qacc=_blend(self.qacc, i, a),
             swing=_blend(self.swing, i, a),
             com=_blend(self.com, i, a),
-            sites=_blend(self.sites, i, a),
         )
 
-    def sites_at(self, clocks: np.ndarray) -> np.ndarray:
-        """``(T', 17, 3)`` body17 sites at the fractional frames ``clocks (T',)``, as
-        :meth:`at` (vectorised)."""
+    def sites_at(self, clocks: np.ndarray | float) -> np.ndarray:
+        """``(..., 17, 3)`` body17 sites at the fractional frames ``clocks (...)``,
+        interpolated as :meth:`at`."""
         _, i, a = self._interpolation(clocks)
         return _blend(self.sites, i, a)
 
@@ -142,13 +140,14 @@ class Reference:
         """Clamped ``clocks``, the frame ``i`` before each and the weight ``a`` of the next."""
         n = self.n_frames
         frame = np.minimum(clocks, n - 1.0)
-        i = np.minimum(np.asarray(frame).astype(int), n - 2)
+        i = np.minimum(frame.astype(int), n - 2)
         return frame, i, frame - i
 
 
 def _blend(values: np.ndarray, i: np.ndarray | int, a: np.ndarray | float) -> np.ndarray:
     """``(1 - a) values[i] + a values[i + 1]``, ``a`` broadcast over the trailing axes."""
-    a = np.reshape(a, np.shape(a) + (1,) * (values.ndim - 1))
+    if isinstance(a, np.ndarray) and a.ndim:  # a scalar (one clock) broadcasts as it is
+        a = a.reshape(a.shape + (1,) * (values.ndim - 1))
     return (1 - a) * values[i] + a * values[i + 1]
 
 

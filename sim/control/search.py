@@ -157,7 +157,7 @@ def state_cost(
     (module docstring); infinity once fallen."""
     d = controller.data
     point = ref.at(progress.clock)
-    q_ref, sites = point.frame_qpos, point.sites
+    q_ref, sites = ref.frame_qpos(point.frame), ref.sites_at(point.frame)
     now = d.site_xpos[controller.body.sites]
     unstable = controller.unstable()
     if fallen(controller.settings, d.qpos[None], q_ref[None], now[None], sites[None], unstable)[0]:

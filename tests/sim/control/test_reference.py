@@ -32,8 +32,8 @@ def test_reference_at_a_frame_is_that_frame(walk_reference):
     for frame in (0, 7, ref.n_frames - 1):
         point = ref.at(float(frame))
         np.testing.assert_allclose(point.qpos, ref.qpos[frame], atol=1e-12)
-        np.testing.assert_array_equal(point.frame_qpos, ref.qpos[frame])
-        np.testing.assert_allclose(point.sites, ref.sites[frame], atol=1e-12)
+        np.testing.assert_array_equal(ref.frame_qpos(point.frame), ref.qpos[frame])
+        np.testing.assert_allclose(ref.sites_at(float(frame)), ref.sites[frame], atol=1e-12)
         np.testing.assert_allclose(point.com, ref.com[frame], atol=1e-12)
 
 
@@ -44,15 +44,15 @@ def test_reference_between_frames_is_linear_and_held_past_the_end(walk_reference
     ref = walk_reference
     point = ref.at(4.5)
     np.testing.assert_allclose(point.qvel, (ref.qvel[4] + ref.qvel[5]) / 2, atol=1e-12)
-    np.testing.assert_allclose(point.sites, (ref.sites[4] + ref.sites[5]) / 2, atol=1e-12)
+    np.testing.assert_allclose(ref.sites_at(4.5), (ref.sites[4] + ref.sites[5]) / 2, atol=1e-12)
     np.testing.assert_allclose(point.qpos[7:], (ref.qpos[4, 7:] + ref.qpos[5, 7:]) / 2, atol=1e-9)
-    np.testing.assert_array_equal(point.frame_qpos, ref.qpos[4])  # 4.5 rounds to even
+    np.testing.assert_array_equal(ref.frame_qpos(4.5), ref.qpos[4])  # 4.5 rounds to even
     assert mujoco.mju_norm(point.qpos[3:7]) == pytest.approx(1.0)
     last = ref.at(ref.n_frames + 3.0)
     assert last.frame == ref.n_frames - 1
-    np.testing.assert_allclose(last.sites, ref.sites[-1], atol=1e-12)
+    np.testing.assert_allclose(ref.sites_at(ref.n_frames + 3.0), ref.sites[-1], atol=1e-12)
     clocks = np.array([0.0, 4.5, ref.n_frames - 1.0])
-    np.testing.assert_array_equal(ref.sites_at(clocks)[1], point.sites)
+    np.testing.assert_array_equal(ref.sites_at(clocks)[1], ref.sites_at(4.5))
 
 
 def test_clip_too_short_to_loop_is_refused(body):
