@@ -221,8 +221,11 @@ def angle(q: np.ndarray) -> np.ndarray:
 
 def yaw(q: np.ndarray) -> np.ndarray:
     """Heading angle about +Z of each rotation's +X axis (radians)."""
-    fwd = rotate(q, np.array([1.0, 0.0, 0.0]))
-    return np.arctan2(fwd[..., 1], fwd[..., 0])
+    # The x and y of rotate(q, +X), written out: equal to the last bit, without the two
+    # cross products (a per-frame hot path of the physics controller).
+    q = np.asarray(q, dtype=float)
+    w, x, y, z = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    return np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
 
 
 def make_continuous(q: np.ndarray, axis: int = 0) -> np.ndarray:

@@ -14,7 +14,7 @@ import threading
 import warnings
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
@@ -22,6 +22,11 @@ from rich.markup import escape
 
 from avatar_models.errors import AvatarsimError, MotionValueError
 from scripts.scenario import MIN_FRAMES  # noqa: F401  (re-exported for the commands)
+
+if TYPE_CHECKING:  # imported by the commands that use them (keeps `--help` fast)
+    import numpy as np
+
+    from sim.humanoid import Humanoid
 
 INTERNAL_ERROR = 3  # exit code of a bug (0 ok, 1 a check failed, 2 bad input)
 
@@ -178,6 +183,19 @@ def emit_json(path: Path | None, payload: dict[str, Any]) -> None:
         from avatar_models.fileio import write_json
 
         write_json(path, payload)
+
+
+def export_viewer(humanoid: Humanoid, qpos: np.ndarray, fps: float, export: Path) -> None:
+    """Write ``qpos (T, nq)`` of ``humanoid`` at ``fps`` into ``export`` for MuJoCo's viewer
+    (:func:`sim.export.export_replay`) and say how to open it."""
+    from sim.export import export_replay
+
+    export_replay(humanoid, qpos, fps, export)
+    console.print(
+        escape(
+            f"MuJoCo viewer files in {export}/ (python -m mujoco.viewer --mjcf {export}/replay.xml)"
+        )
+    )
 
 
 def unit_option(unit: str | None) -> dict[str, Any]:

@@ -14,7 +14,7 @@ PICTURES = (
     ("compare_gif", "Ground truth next to each synthesis method (animated)"),
     ("cameras_png", "What the devices see: controller fisheye cameras and a Kinect depth frame"),
     ("physics_plot", "Physics plausibility over time"),
-    ("tracking_plot", "The humanoid tracking the ground truth under physics, root unactuated"),
+    ("control_plot", "The humanoid following the ground truth under physics, root unactuated"),
 )
 MIME = {".png": "image/png", ".gif": "image/gif"}
 

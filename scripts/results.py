@@ -149,11 +149,12 @@ def _files_in(folder: Path) -> set[str]:
 
 
 def _earlier_output(folder: Path, owner: str, present: set[str]) -> set[str]:
-    """The files of an output written before :data:`OUTPUT_MARKER` existed: ``track``'s
-    three files, or a run's folder (``results.json`` naming its outputs, whose folders hold
-    the rest). Empty when ``folder`` is not such an output."""
+    """The files of an output written before :data:`OUTPUT_MARKER` existed: the three files
+    of ``control`` (then called ``track``, its files ``tracking.*``), or a run's folder
+    (``results.json`` naming its outputs, whose folders hold the rest). Empty when ``folder``
+    is not such an output."""
     try:
-        if owner == "track":
+        if owner == "control":
             names = {"tracking.csv", "tracking.json", "tracking.png"}
             summary = json.loads((folder / "tracking.json").read_text(encoding="utf-8"))
             return present if present <= names and "mode" in summary else set()

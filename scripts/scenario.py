@@ -17,7 +17,7 @@ A scenario names a motion source, the body, the stages to run and pass/fail thre
     replay_error_mm_max = 1.0
     [physics]                 # sim.thresholds.CheckConfig overrides (definitions, thresholds)
     skate_cm_s_median = 40.0
-    [tracking]                # physics tracking of the ground truth (optional)
+    [control]                 # physics control of the ground truth (optional)
     seconds = 3.0
     search = true             # false: the plain controller (fast, lasts a few steps)
     expect_fail = ["penetration_cm_p95"]  # checks that must fail (a suite proving a detector)
@@ -49,7 +49,7 @@ CORRUPTIONS = ("sink_feet", "float_body", "bend_knee", "inject_sliding", "add_ji
 # compute for hours or measure nothing.
 MIN_FRAMES = 3  # velocities need 2 frames, accelerations (residual forces, jitter) 3
 MAX_MOTION_S = 600.0  # seconds of motion a scenario runs on
-MAX_TRACK_S = 600.0  # seconds tracked under physics (the search runs slower than real time)
+MAX_CONTROL_S = 600.0  # seconds followed under physics (the search runs slower than real time)
 MAX_PICTURE_FRAMES = 50  # frames in the report's strip
 GIF_FPS_RANGE = (1.0, 60.0)  # frame rates a GIF viewer plays
 MAX_STRIP_SPAN_S = 60.0
@@ -126,9 +126,9 @@ class CamerasSpec:
 
 
 @dataclass(frozen=True)
-class TrackingSpec:
-    """Physics tracking of the ground truth (``sim.sampling`` search, or the plain
-    controller): ``seconds`` tracked from the start, the clip looped when shorter."""
+class ControlSpec:
+    """Physics control of the ground truth (the search of ``sim.control.search``, or the
+    plain controller): ``seconds`` followed from the start, the clip looped when shorter."""
 
     seconds: float = 3.0
     search: bool = True
@@ -163,7 +163,7 @@ class Scenario:
     devices: DevicesSpec | None = None
     synthesis: SynthesisSpec | None = None
     cameras: CamerasSpec | None = None
-    tracking: TrackingSpec | None = None
+    control: ControlSpec | None = None
     thresholds: dict[str, Threshold] = field(default_factory=dict)
     physics: dict[str, float] = field(default_factory=dict)
     expect_fail: tuple[str, ...] = ()
@@ -224,7 +224,7 @@ def _threshold(name: str, raw: Any) -> Threshold:
 def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
     """Validate a parsed TOML table into a :class:`Scenario`."""
     top = {"name", "seed", "motion", "body", "report", "devices", "synthesis", "cameras"}
-    top |= {"tracking", "thresholds", "physics", "expect_fail", "regression"}
+    top |= {"control", "thresholds", "physics", "expect_fail", "regression"}
     unknown = sorted(set(data) - top)
     if unknown:
         raise ScenarioError(f"unknown top-level key(s) {unknown}; allowed: {sorted(top)}")
@@ -237,11 +237,11 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
             ("devices", DevicesSpec),
             ("synthesis", SynthesisSpec),
             ("cameras", CamerasSpec),
-            ("tracking", TrackingSpec),
+            ("control", ControlSpec),
         )
     }
-    if optional["tracking"] and not 0 < optional["tracking"].seconds <= MAX_TRACK_S:
-        raise ScenarioError(f"tracking.seconds must be above 0 and at most {MAX_TRACK_S:g}")
+    if optional["control"] and not 0 < optional["control"].seconds <= MAX_CONTROL_S:
+        raise ScenarioError(f"control.seconds must be above 0 and at most {MAX_CONTROL_S:g}")
     if optional["devices"] and optional["devices"].noise not in VR_NOISE:
         raise ScenarioError(f"devices.noise must be one of {VR_NOISE}")
     for key, most in DEVICE_SWEEP_MAX.items():

@@ -10,8 +10,8 @@ passes the :class:`Humanoid` along; nothing downstream rebuilds a body from a sk
   humanoid sized to it (:func:`sim.retarget.sizing.humanoid_body`, :func:`sim.retarget.retarget`);
   its per-frame residual is kept.
 
-Physics tracking needs stance feet flat on the floor (:func:`sim.retarget.feet.level_stance_feet`
-and the repairs around it); :meth:`Humanoid.for_tracking` gives that reference on the same body
+Physics control needs stance feet flat on the floor (:func:`sim.retarget.feet.level_stance_feet`
+and the repairs around it); :meth:`Humanoid.for_control` gives that reference on the same body
 and model, retargeting again only for a foreign rig.
 
 Shapes: ``T`` frames, ``nq`` MuJoCo position coordinates.
@@ -47,7 +47,7 @@ class Humanoid:
         model: ``body.spec`` compiled once (:attr:`BodyDescription.model`), shared by every
             stage: read it, do not edit it (physics control compiles its own variant,
             :meth:`control_model`).
-        levelled: whether stance feet were levelled for tracking.
+        levelled: whether stance feet were levelled for physics control.
     """
 
     body: BodyDescription
@@ -78,8 +78,8 @@ class Humanoid:
         (:func:`avatar_models.body.control_spec`): motors, only floor contacts."""
         return control_spec(self.body.spec).compile()
 
-    def for_tracking(self) -> Humanoid:
-        """This humanoid with stance feet levelled for physics tracking (module docstring);
+    def for_control(self) -> Humanoid:
+        """This humanoid with stance feet levelled for physics control (module docstring);
         itself for an own rig, whose feet are the source's."""
         if not self.retargeted or self.levelled:
             return self
@@ -113,7 +113,7 @@ def humanoid_for(
         height_m: scale the motion uniformly (skeleton and root path) to this standing
             height first; ``None`` keeps its own size.
         mass_kg: body mass (default: the built-in subject's, else 75 kg).
-        level_feet: level stance feet for tracking right away (see :meth:`for_tracking`).
+        level_feet: level stance feet for control right away (see :meth:`for_control`).
 
     Raises:
         MotionValueError: a rig with no body17 map, a height outside (0, 3] m.

@@ -18,7 +18,7 @@ BENCHMARKS: dict[str, str] = {
     "coolmoves": "coolmoves",
     "cameras": "cameras",
     "kinect": "kinect",
-    "tracking": "tracking",
+    "control": "control",
     "suite": "suite",
 }
 

@@ -24,6 +24,7 @@ from scripts.cli_common import (
     check_outputs,
     console,
     emit_json,
+    export_viewer,
     load_motion_arg,
     user_errors,
 )
@@ -100,15 +101,7 @@ def register(app: typer.Typer) -> None:
         console.print(table)
         written = write_outputs(report, out)
         if export is not None:
-            from sim.export import export_replay
-
-            export_replay(humanoid, humanoid.qpos, m.fps, export)
-            console.print(
-                escape(
-                    f"MuJoCo viewer files in {export}/ (python -m mujoco.viewer --mjcf "
-                    f"{export}/replay.xml)"
-                )
-            )
+            export_viewer(humanoid, humanoid.qpos, m.fps, export)
         console.print(escape(f"wrote {', '.join(str(p) for p in written.values())}"))
         emit_json(json_out, report.contract())
         if not report.passed:

@@ -4,12 +4,12 @@ of :data:`STAGES` is the data flow of ARCHITECTURE.md."""
 from scripts.stages import (
     body,
     cameras,
+    control,
     devices,
     motion,
     physics,
     pictures,
     synthesis,
-    tracking,
 )
 
-STAGES = (motion, body, physics, tracking, devices, synthesis, cameras, pictures)
+STAGES = (motion, body, physics, control, devices, synthesis, cameras, pictures)

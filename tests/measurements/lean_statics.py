@@ -1,5 +1,5 @@
 """Ankle torques of a body held leaning 4 degrees forward against what statics demands
-(tests/sim/test_tracking.py).
+(tests/sim/control/test_qp.py).
 
     .venv/bin/python -m tests.measurements.lean_statics
 """
@@ -11,7 +11,7 @@ import numpy as np
 from avatar_models.body import build_body
 from avatar_models.generator import generate, sample_subject
 from avatar_models.rigs import load_rig
-from tests.sim.test_tracking import ankle_balance
+from tests.sim.control.test_qp import ankle_balance
 
 
 def main() -> None:

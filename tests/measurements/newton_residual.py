@@ -1,4 +1,5 @@
-"""Newton residual of the whole body during a tracked built-in walk (tests/sim/test_tracking.py).
+"""Newton residual of the whole body during a controlled built-in walk
+(tests/sim/control/test_controller.py).
 
     .venv/bin/python -m tests.measurements.newton_residual 0 1 2 3
 
@@ -13,13 +14,13 @@ import numpy as np
 
 from avatar_models.body import build_body
 from avatar_models.rigs import load_rig
-from tests.sim.test_tracking import _newton_residual_bw
+from tests.sim.control.test_controller import newton_residual_bw
 
 
 def main(seeds: list[int]) -> None:
     body = build_body(load_rig("avatar").skeleton)
     for seed in seeds:
-        r = _newton_residual_bw(body, 2.0, seed=seed)
+        r = newton_residual_bw(body, 2.0, seed=seed)
         print(f"seed {seed}: mean {r.mean():.4f} p95 {np.percentile(r, 95):.4f} max {r.max():.4f}")
 
 

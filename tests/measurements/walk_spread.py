@@ -1,4 +1,4 @@
-"""How far the plain tracking controller gets on built-in walks (tests/sim/test_tracking.py).
+"""How far the plain controller gets on built-in walks (tests/sim/control/test_controller.py).
 
     .venv/bin/python -m tests.measurements.walk_spread
 
@@ -16,7 +16,7 @@ import numpy as np
 from avatar_models.body import build_body
 from avatar_models.body.ik import humanoid_model
 from avatar_models.generator import generate, sample_subject
-from sim.tracking import track
+from sim.control.controller import control
 
 
 def main() -> None:
@@ -25,7 +25,7 @@ def main() -> None:
     for subject, seed in cases:
         walk = generate("walk", subject, duration_s=2.0, fps=30.0, seed=seed)
         body = build_body(walk.skeleton)
-        r = track(humanoid_model(body), body.qpos_from_motion(walk), walk.fps)
+        r = control(humanoid_model(body), body.qpos_from_motion(walk), walk.fps)
         e = 100 * r.body17_error.mean(axis=1)
         row = {
             "height_m": None if subject is None else round(subject.height_m, 2),

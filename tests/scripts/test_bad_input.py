@@ -53,7 +53,7 @@ def commands_with(kind: str, target: str, scenario: Path) -> list[list[str]]:
     if kind == "out":
         return [
             ["check", "builtin:walk", "--out", target],
-            ["track", "builtin:walk", "--out", target],
+            ["control", "builtin:walk", "--out", target],
             ["render", "builtin:walk", "--out", target],
             ["eval", "coolmoves", "--out", target],
             ["run", str(scenario), "--out", target],
@@ -64,7 +64,7 @@ def commands_with(kind: str, target: str, scenario: Path) -> list[list[str]]:
         ["info", "builtin:walk", "--json", target],
         ["convert", "builtin:walk", str(Path(target).parent / "ok.bvh"), "--json", target],
         ["check", "builtin:walk", "--json", target],
-        ["track", "builtin:walk", "--json", target],
+        ["control", "builtin:walk", "--json", target],
         ["render", "builtin:walk", "--json", target],
         ["eval", "coolmoves", "--json", target],
         ["run", str(scenario), "--json", target],
@@ -114,33 +114,35 @@ def test_read_only_folder_exits_2(tmp_path, scenario):
 
 
 # -- data loss and leftovers ---------------------------------------------------------------
-@pytest.mark.parametrize("command", ["track", "run"])
+@pytest.mark.parametrize("command", ["control", "run"])
 def test_out_holding_a_users_file_is_refused_and_kept(tmp_path, scenario, command):
     out = tmp_path / "mine"
     out.mkdir()
     (out / "notes.txt").write_text("my notes")
-    target = ["track", "builtin:walk", "--plain"] if command == "track" else ["run", str(scenario)]
+    target = (
+        ["control", "builtin:walk", "--plain"] if command == "control" else ["run", str(scenario)]
+    )
     bad([*target, "--out", str(out)], "notes.txt", "not written by `avatarsim")
     assert (out / "notes.txt").read_text() == "my notes"
     assert [p.name for p in out.iterdir()] == ["notes.txt"]
     no_partials(tmp_path)
 
 
-def test_track_replaces_its_own_output_but_not_a_file_added_to_it(tmp_path, clip):
+def test_control_replaces_its_own_output_but_not_a_file_added_to_it(tmp_path, clip):
     out = tmp_path / "o"
-    args = ["track", str(clip), "--plain", "--seconds", "0.3", "--out", str(out)]
+    args = ["control", str(clip), "--plain", "--seconds", "0.3", "--out", str(out)]
     first = runner.invoke(app, args)
     assert first.exit_code in (0, 1), first.output
-    assert (out / "tracking.json").is_file() and (out / ".avatarsim-output.json").is_file()
+    assert (out / "control.json").is_file() and (out / ".avatarsim-output.json").is_file()
     marker = json.loads((out / ".avatarsim-output.json").read_text())
-    assert marker["command"] == "track" and "tracking.json" in marker["files"]
-    again = runner.invoke(app, args)  # a previous output of track: replaced
+    assert marker["command"] == "control" and "control.json" in marker["files"]
+    again = runner.invoke(app, args)  # a previous output of control: replaced
     assert again.exit_code == first.exit_code, again.output
     (out / "keep.txt").write_text("mine")
     bad(args, "keep.txt")
     assert (out / "keep.txt").read_text() == "mine"
-    # Another command's output is not track's to replace either.
-    bad(["run", str(tmp_path / "none.toml"), "--out", str(out)], "keep.txt")
+    # Another command's output is not control's to replace either.
+    bad(["run", str(tmp_path / "none.toml"), "--out", str(out)], "output of `avatarsim control`")
     no_partials(tmp_path)
 
 
@@ -163,9 +165,9 @@ def test_atomic_dir_cleans_up_and_keeps_the_old_output_when_the_block_fails(tmp_
     from scripts.results import atomic_dir
 
     out = tmp_path / "o"
-    with atomic_dir(out, "track") as partial:
+    with atomic_dir(out, "control") as partial:
         (partial / "a.txt").write_text("1")
-    with pytest.raises(KeyboardInterrupt), atomic_dir(out, "track") as partial:
+    with pytest.raises(KeyboardInterrupt), atomic_dir(out, "control") as partial:
         (partial / "a.txt").write_text("2")
         raise KeyboardInterrupt
     assert (out / "a.txt").read_text() == "1"
@@ -212,8 +214,8 @@ def test_absurd_numbers_exit_2(tmp_path, clip):
     out = str(tmp_path / "o")
     bad(["convert", str(clip), str(tmp_path / "x.bvh"), "--fps", "1e9"], "--fps", "1-1000")
     bad(["convert", str(clip), str(tmp_path / "x.bvh"), "--fps", "nan"], "--fps")
-    bad(["track", str(clip), "--seconds", "inf", "--out", out], "--seconds", "at most 600")
-    bad(["track", str(clip), "--samples", "100000", "--out", out], "--samples")
+    bad(["control", str(clip), "--seconds", "inf", "--out", out], "--seconds", "at most 600")
+    bad(["control", str(clip), "--samples", "100000", "--out", out], "--samples")
     bad(["render", str(clip), "--duration-s", "inf", "--out", out], "--duration-s")
     bad(["render", str(clip), "--size", "40000,30000", "--out", out], "--size", "16-4096")
     bad(["render", str(clip), "--fov", "nan,90", "--out", out], "--fov")
@@ -231,7 +233,7 @@ def test_absurd_numbers_exit_2(tmp_path, clip):
         ("[thresholds]\nframes = { min = 10, max = 5 }\n", "min 10 is above max 5"),
         ("[motion]\nduration_s = inf\n", "motion.duration_s"),
         ("[motion]\nfps = 1e9\n", "motion.fps"),
-        ("[tracking]\nseconds = 1e6\n", "tracking.seconds"),
+        ("[control]\nseconds = 1e6\n", "control.seconds"),
         ("[body]\nmass_kg = 1e9\n", "body.mass_kg"),
     ],
 )
@@ -253,7 +255,7 @@ def test_a_one_frame_clip_is_too_short(tmp_path):
     one = bvh(tmp_path, n=1)
     out = str(tmp_path / "o")
     bad(["check", str(one), "--out", out], "too short", "1 frame")
-    bad(["track", str(one), "--out", out], "too short")
+    bad(["control", str(one), "--out", out], "too short")
     sc = tmp_path / "s.toml"
     sc.write_text(f'[motion]\nsource = "{one}"\nfps = 30.0\n')
     bad(["run", str(sc), "--out", out], "too short")
@@ -267,7 +269,7 @@ def test_a_one_frame_clip_is_too_short(tmp_path):
 def test_a_wrong_unit_giving_no_persons_height_exits_2(tmp_path):
     path = save_motion(generate("walk", duration_s=0.5), tmp_path / "w.bvh")  # written in cm
     bad(["check", str(path), "--unit", "mm", "--out", str(tmp_path / "o")], "--unit cm", "tall")
-    bad(["track", str(path), "--unit", "inch", "--out", str(tmp_path / "o")], "--unit cm")
+    bad(["control", str(path), "--unit", "inch", "--out", str(tmp_path / "o")], "--unit cm")
     bad(["convert", str(path), str(tmp_path / "x.npz"), "--unit", "m"], "--unit cm")
     info = runner.invoke(app, ["info", str(path), "--unit", "mm"])
     assert info.exit_code == 0 and "warning" in info.output and "--unit cm" in info.output
@@ -393,11 +395,11 @@ def test_an_output_from_before_the_marker_is_still_replaced(tmp_path):
 
     out = tmp_path / "t"
     out.mkdir()
-    (out / "tracking.json").write_text('{"mode": "plain"}')
+    (out / "tracking.json").write_text('{"mode": "plain"}')  # as `track` wrote them then
     (out / "tracking.csv").write_text("a\n")
-    with atomic_dir(out, "track") as partial:
-        (partial / "tracking.json").write_text('{"mode": "search"}')
-    assert sorted(p.name for p in out.iterdir()) == [".avatarsim-output.json", "tracking.json"]
+    with atomic_dir(out, "control") as partial:
+        (partial / "control.json").write_text('{"mode": "search"}')
+    assert sorted(p.name for p in out.iterdir()) == [".avatarsim-output.json", "control.json"]
     run = tmp_path / "r"
     (run / "physics").mkdir(parents=True)
     (run / "physics" / "check.csv").write_text("x")
@@ -461,9 +463,9 @@ def test_numpy_warnings_never_come_before_the_error_line(tmp_path, monkeypatch):
 def test_out_that_is_the_working_folder_or_holds_the_export_exits_2(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     for args in (
-        ["track", "builtin:walk", "--plain", "--seconds", "0.5", "--out", "."],
-        ["track", "builtin:walk", "--plain", "--seconds", "0.5", "--out", "o", "--export", "o"],
-        ["track", "builtin:walk", "--plain", "--seconds", "0.5", "--out", "o", "--export", "o/v"],
+        ["control", "builtin:walk", "--plain", "--seconds", "0.5", "--out", "."],
+        ["control", "builtin:walk", "--plain", "--seconds", "0.5", "--out", "o", "--export", "o"],
+        ["control", "builtin:walk", "--plain", "--seconds", "0.5", "--out", "o", "--export", "o/v"],
     ):
         result = runner.invoke(app, args)
         assert result.exit_code == 2, (args, result.output)

@@ -25,8 +25,8 @@ CLIPS = {
 }
 """Source -> clip and the second its slice starts at."""
 SLICE_S = 1.1
-"""Slice length: enough for every stage (a 0.5 s track loops a gait cycle of at least 0.8 s)."""
-COMMANDS = ("info", "convert", "check", "track", "fisheye", "kinect-v2", "azure-kinect", "run")
+"""Slice length: enough for every stage (a 0.5 s control run loops a gait cycle of >= 0.8 s)."""
+COMMANDS = ("info", "convert", "check", "control", "fisheye", "kinect-v2", "azure-kinect", "run")
 
 SCENARIO = """
 name = "matrix-{source}"
@@ -48,7 +48,7 @@ database_duration_s = 4.0
 [cameras]
 fisheye = true
 kinect = "kinect-v2"
-[tracking]
+[control]
 seconds = 0.5
 search = false
 """
@@ -75,8 +75,8 @@ def _invoke(command: str, motion: str, tmp: Path) -> tuple[int, str]:
         args = ["convert", motion, str(tmp / "converted.npz"), "--fps", "60"]
     elif command == "check":
         args = ["check", motion, "--out", str(tmp / "out"), "--json", str(js)]
-    elif command == "track":
-        args = ["track", motion, "--seconds", "0.5", "--plain", "--out", str(tmp / "out")]
+    elif command == "control":
+        args = ["control", motion, "--seconds", "0.5", "--plain", "--out", str(tmp / "out")]
         args += ["--json", str(js)]
     elif command == "run":
         source, builtin = motion, ""
@@ -107,7 +107,7 @@ def test_every_command_on_every_source(sliced, source, command, tmp_path):
         assert 1.0 < payload["height_m"] < 2.2, payload
     elif command == "check":
         assert payload["meta"]["retargeted"] == source.startswith("bandai")
-    elif command == "track":
+    elif command == "control":
         assert payload["duration_s"] == pytest.approx(0.5, abs=0.05) or code == 1
     elif command == "run":
         assert payload["metrics"]["replay_error_mm_max"] < 1.0  # qpos replays the motion

@@ -33,8 +33,8 @@ def test_default_scenario_is_valid():
         ({"seed": 1.5}, "seed must be int"),
         ({"thresholds": {"x": "big"}}, "must be a number"),
         ({"thresholds": {"x": {"maximum": 1}}}, "must be a number"),
-        ({"tracking": {"seconds": 0}}, "tracking.seconds must be above 0"),
-        ({"tracking": {"search": "yes"}}, "tracking.search must be bool"),
+        ({"control": {"seconds": 0}}, "control.seconds must be above 0"),
+        ({"control": {"search": "yes"}}, "control.search must be bool"),
         ({"expect_fail": "frames"}, "expect_fail must be a list"),
         ({"regression": {"frames": -1}}, "tolerances must be finite numbers, 0 or more"),
         ({"regression": {"frames": "big"}}, "regression.frames must be float"),
@@ -86,9 +86,9 @@ def test_non_finite_thresholds_are_rejected():
         parse_scenario({"thresholds": {"frames": float("nan")}})
 
 
-def test_tracking_thresholds_need_the_tracking_stage():
+def test_control_thresholds_need_the_control_stage():
     from scripts.pipeline import validate
 
     with pytest.raises(ScenarioError, match="does not produce"):
-        validate(parse_scenario({"thresholds": {"tracking_fell": 0.0}}))
-    validate(parse_scenario({"tracking": {}, "thresholds": {"tracking_fell": 0.0}}))
+        validate(parse_scenario({"thresholds": {"control_fell": 0.0}}))
+    validate(parse_scenario({"control": {}, "thresholds": {"control_fell": 0.0}}))

@@ -45,7 +45,7 @@ def test_own_rig_is_exact_and_not_retargeted():
     control = h.control_model()
     assert control is not h.model and not control.actuator_ctrllimited.any()
     assert h.model.actuator_ctrllimited.all()
-    assert h.for_tracking() is h  # own feet: nothing to level
+    assert h.for_control() is h  # own feet: nothing to level
 
 
 def test_height_scales_motion_and_body_together():
@@ -79,9 +79,9 @@ def test_bandai_is_retargeted_once_and_levelled_on_the_same_model(mocap_dir):
     measured = 100 * np.linalg.norm(_site_positions(h) - body17_positions(motion), axis=-1)
     assert np.allclose(h.residual_cm, measured.mean(axis=1), atol=1e-6)
     assert h.residual_cm.mean() < 1.0
-    levelled = h.for_tracking()
+    levelled = h.for_control()
     assert levelled.levelled and levelled.model is h.model and levelled.body is h.body
-    assert levelled.for_tracking() is levelled
+    assert levelled.for_control() is levelled
 
 
 def test_a_subject_label_is_not_a_subject_record():

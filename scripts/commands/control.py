@@ -1,10 +1,12 @@
-"""``avatarsim track MOTION``: the MuJoCo humanoid tracks a motion under physics, root unactuated.
+"""``avatarsim control MOTION``: the MuJoCo humanoid follows a motion under physics, root
+unactuated.
 
-By default the sampling search of ``sim.sampling`` (SAMCON-style beam search over the
-whole-body controller's targets); ``--plain`` runs the controller alone (``sim.tracking``,
-about 10x real time, lasts a few steps on a walk). A clip shorter than ``--seconds`` is
-looped on its best gait cycle (``sim.tracking.looped``); a foreign rig is retargeted with its
-stance feet levelled. Writes ``tracking.csv``, ``tracking.json``, ``tracking.png`` into
+By default the search of ``sim.control.search`` (SAMCON-style beam search over the
+whole-body controller's targets); ``--plain`` runs the controller alone
+(``sim.control.controller``, about 10x real time, lasts a few steps on a walk). A clip shorter
+than ``--seconds`` is looped on its best gait cycle (``sim.control.reference.looped``); a
+foreign rig is retargeted with its stance feet levelled. Writes ``control.csv``,
+``control.json``, ``control.png`` into
 ``--out`` (replaced only when the run completes), optionally the simulated motion for MuJoCo's
 viewer into ``--export``. Exit 1 when the humanoid falls or the search gives up before the
 requested time (the reason is in the table and the JSON's ``failure``), 2 for bad input.
@@ -27,10 +29,11 @@ from scripts.cli_common import (
     console,
     emit_json,
     err_console,
+    export_viewer,
     load_motion_arg,
     user_errors,
 )
-from scripts.scenario import MAX_TRACK_S
+from scripts.scenario import MAX_CONTROL_S
 
 MAX_SEARCH = 64  # samples or beam: 64 x 64 simulations per window is hours per second
 
@@ -38,7 +41,7 @@ MAX_SEARCH = 64  # samples or beam: 64 x 64 simulations per window is hours per 
 def register(app: typer.Typer) -> None:
     @app.command()
     @user_errors
-    def track(
+    def control(
         motion: Annotated[
             str,
             typer.Argument(help="A .bvh, .amc (ASF beside it) or .npz file, or builtin:ACTIVITY."),
@@ -46,7 +49,7 @@ def register(app: typer.Typer) -> None:
         seconds: Annotated[
             float | None,
             typer.Option(
-                help=f"Length to track (s, at most {MAX_TRACK_S:g}); loops a shorter clip. "
+                help=f"Length to follow (s, at most {MAX_CONTROL_S:g}); loops a shorter clip. "
                 "Default: the clip."
             ),
         ] = None,
@@ -60,7 +63,7 @@ def register(app: typer.Typer) -> None:
             int, typer.Option(help=f"Search: states kept per window (1-{MAX_SEARCH}).")
         ] = 6,
         out: Annotated[Path, typer.Option(help="Folder for CSV, JSON and plot.")] = Path(
-            "out/track"
+            "out/control"
         ),
         export: Annotated[
             Path | None, typer.Option(help="Also write the simulated motion for MuJoCo's viewer.")
@@ -69,27 +72,28 @@ def register(app: typer.Typer) -> None:
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
     ) -> None:
-        """Physics tracking of a motion by the MuJoCo humanoid. Exit 1 if it falls or does not
+        """Drive the humanoid under physics to follow a motion. Exit 1 if it falls or does not
         reach the requested time."""
         from avatar_models.errors import MotionValueError
 
-        if seconds is not None and not 0 < seconds <= MAX_TRACK_S:
+        if seconds is not None and not 0 < seconds <= MAX_CONTROL_S:
             raise MotionValueError(
-                f"--seconds must be above 0 and at most {MAX_TRACK_S:g}, got {seconds}"
+                f"--seconds must be above 0 and at most {MAX_CONTROL_S:g}, got {seconds}"
             )
         if not (1 <= samples <= MAX_SEARCH and 1 <= beam <= MAX_SEARCH):
             raise MotionValueError(f"--samples and --beam must be 1-{MAX_SEARCH}")
-        check_outputs(json_out=json_out, out=out, out_owner="track", export=export)
+        check_outputs(json_out=json_out, out=out, out_owner="control", export=export)
+        from scripts.control_run import timed_control
         from scripts.results import atomic_dir
+        from sim.control.reference import looped
+        from sim.control.report import write_outputs
+        from sim.control.search import SearchSettings
         from sim.humanoid import humanoid_for
-        from sim.sampling import SearchSettings, timed_tracking
-        from sim.tracking import looped
-        from sim.tracking_report import write_outputs
 
         m = load_motion_arg(motion, unit, seed, duration_s=seconds or 10.0, min_frames=MIN_FRAMES)
-        if seconds is None and m.duration_s > MAX_TRACK_S:
+        if seconds is None and m.duration_s > MAX_CONTROL_S:
             raise MotionValueError(
-                f"the clip is {m.duration_s:.0f} s long; at most {MAX_TRACK_S:g} s are tracked "
+                f"the clip is {m.duration_s:.0f} s long; at most {MAX_CONTROL_S:g} s are followed "
                 "(pass --seconds)"
             )
         humanoid = humanoid_for(m, level_feet=True)
@@ -99,17 +103,17 @@ def register(app: typer.Typer) -> None:
         summary_extra = {"motion": motion, "seed": seed, "fps": m.fps}
         summary_extra |= humanoid.summary()
         search = None if plain else SearchSettings(samples=samples, beam=beam, seed=seed)
-        result, summary = timed_tracking(humanoid.model, qpos, m.fps, search, progress_bar=True)
+        result, summary = timed_control(humanoid.model, qpos, m.fps, search, progress_bar=True)
         summary |= summary_extra
         wall = summary["wall_s"]
-        table = Table(title=f"physics tracking ({summary['mode']}): {escape(motion)}")
+        table = Table(title=f"physics control ({summary['mode']}): {escape(motion)}")
         for col in ("quantity", "value"):
             table.add_column(col)
         fell = "never" if not result.fell else f"[red]at {result.fall_time_s:.2f} s[/]"
-        tracked = f"{summary['duration_s']:.2f} s of {summary['requested_s']:.2f} s"
+        followed = f"{summary['duration_s']:.2f} s of {summary['requested_s']:.2f} s"
         outcome = "[green]completed[/]" if summary["completed"] else f"[red]{summary['failure']}[/]"
         rows = [
-            ("tracked", tracked),
+            ("followed", followed),
             ("outcome", outcome),
             ("fell", fell),
             (
@@ -123,24 +127,16 @@ def register(app: typer.Typer) -> None:
         for row in rows:
             table.add_row(*row)
         console.print(table)
-        with atomic_dir(out, "track") as partial:
-            written = write_outputs(result, summary, partial, f"physics tracking: {motion}")
+        with atomic_dir(out, "control") as partial:
+            written = write_outputs(result, summary, partial, f"physics control: {motion}")
         console.print(escape(f"wrote {', '.join(str(out / p.name) for p in written.values())}"))
         if export is not None:
-            from sim.export import export_replay
-
-            export_replay(humanoid, result.qpos, m.fps, export)
-            console.print(
-                escape(
-                    f"MuJoCo viewer files in {export}/ (python -m mujoco.viewer --mjcf "
-                    f"{export}/replay.xml)"
-                )
-            )
+            export_viewer(humanoid, result.qpos, m.fps, export)
         emit_json(json_out, summary)
         if not summary["completed"]:
             upright_s = summary["duration_s"] if not result.fell else result.fall_time_s
             err_console.print(
-                f"[red]not tracked to the end:[/] {summary['failure']} after "
+                f"[red]not followed to the end:[/] {summary['failure']} after "
                 f"{upright_s:.2f} s of {summary['requested_s']:.2f} s",
                 highlight=False,
             )

@@ -1,6 +1,6 @@
-"""Outputs of a physics tracking run: per-frame CSV, summary JSON, a plot.
+"""Outputs of a physics control run: per-frame CSV, summary JSON, a plot.
 
-The plot answers what a person asks of a tracking run: how far is each part of the body from
+The plot answers what a person asks of a control run: how far is each part of the body from
 the reference over time and on average, when (if ever) did it fall, how much effort did it
 take (mechanical power), and how much the reference's clock had to bend.
 """
@@ -15,10 +15,10 @@ import numpy as np
 
 from avatar_models.body17 import BODY17
 from avatar_models.fileio import write_json
-from sim.tracking import TrackingResult
+from sim.control.controller import ControlResult
 
 
-def per_frame(result: TrackingResult) -> dict[str, np.ndarray]:
+def per_frame(result: ControlResult) -> dict[str, np.ndarray]:
     """Columns ``(T,)`` each: time, played reference frame, body17 error (cm, mean and per
     site), root height (m), mechanical power (W), mean absolute torque (N m), fallen (0/1)."""
     n = result.qpos.shape[0]
@@ -40,7 +40,7 @@ def per_frame(result: TrackingResult) -> dict[str, np.ndarray]:
     }
 
 
-def write_csv(result: TrackingResult, path: Path) -> Path:
+def write_csv(result: ControlResult, path: Path) -> Path:
     columns = per_frame(result)
     buffer = io.StringIO()
     writer = csv.writer(buffer)
@@ -50,7 +50,7 @@ def write_csv(result: TrackingResult, path: Path) -> Path:
     return Path(path)
 
 
-def write_plot(result: TrackingResult, path: Path, title: str) -> Path:
+def write_plot(result: ControlResult, path: Path, title: str) -> Path:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -93,13 +93,13 @@ def write_plot(result: TrackingResult, path: Path, title: str) -> Path:
 
 
 def write_outputs(
-    result: TrackingResult, summary: dict, out_dir: Path, title: str
+    result: ControlResult, summary: dict, out_dir: Path, title: str
 ) -> dict[str, Path]:
-    """``tracking.csv``, ``tracking.json`` (``summary``), ``tracking.png`` in ``out_dir``."""
+    """``control.csv``, ``control.json`` (``summary``), ``control.png`` in ``out_dir``."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     return {
-        "csv": write_csv(result, out_dir / "tracking.csv"),
-        "json": write_json(out_dir / "tracking.json", summary),
-        "plot": write_plot(result, out_dir / "tracking.png", title),
+        "csv": write_csv(result, out_dir / "control.csv"),
+        "json": write_json(out_dir / "control.json", summary),
+        "plot": write_plot(result, out_dir / "control.png", title),
     }

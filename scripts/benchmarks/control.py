@@ -1,13 +1,13 @@
-"""Physics tracking speed next to real time, how long walks stay upright, and IK
+"""Physics control speed next to real time, how long walks stay upright, and IK
 retargeting frames/s.
 
-Rows: simulated seconds per wall second tracking the built-in walk with the plain controller
-(``sim.tracking``: a whole-body QP every 5 simulation steps, 100 Hz; aim at least 10x real
-time) and with the sampling search (``sim.sampling``: 48 samples of every 0.2 s window, each
+Rows: simulated seconds per wall second following the built-in walk with the plain controller
+(``sim.control.controller``: a whole-body QP every 5 simulation steps, 100 Hz; aim at least 10x
+real time) and with the search (``sim.control.search``: 48 samples of every 0.2 s window, each
 judged 0.2 s later), next to real time (1x); the share of 10 s built-in walks (seeds 0-3)
-tracked without a fall by the search, next to the plain controller's share (not in
+followed without a fall by the search, next to the plain controller's share (not in
 ``--quick``); retargeting frames/s (``sim.retarget``: body17 IK with mink, stance feet levelled for
-tracking, as :func:`sim.humanoid.humanoid_for` does for a foreign rig) on a Bandai walk from
+control, as :func:`sim.humanoid.humanoid_for` does for a foreign rig) on a Bandai walk from
 ``../shared/mocap`` (the built-in walk when that folder is absent), next to the clip's own
 frame rate.
 """
@@ -20,10 +20,10 @@ from pathlib import Path
 from avatar_models.formats import load_motion
 from avatar_models.generator import generate
 from scripts.benchmarks import BenchRow, best_of
+from sim.control.controller import control
+from sim.control.search import search
 from sim.humanoid import humanoid_for
 from sim.retarget import retarget
-from sim.sampling import search_track
-from sim.tracking import track
 
 MOCAP_DIR = Path(__file__).resolve().parents[2].parent / "shared" / "mocap"
 RETARGET_CLIP = "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh"
@@ -34,12 +34,14 @@ def _speed_rows(quick: bool) -> list[BenchRow]:
     walk = generate("walk", duration_s=seconds, fps=30.0)
     h = humanoid_for(walk)
     repeats = 1 if quick else 3
-    plain = best_of(lambda: track(h.model, h.qpos, walk.fps), repeats)
-    search = best_of(lambda: search_track(h.model, h.qpos, walk.fps), 1)
+    plain = best_of(lambda: control(h.model, h.qpos, walk.fps), repeats)
+    searched = best_of(lambda: search(h.model, h.qpos, walk.fps), 1)
     note = f"{seconds:.0f} s walk"
     return [
-        BenchRow("tracking[walk, plain]", "x real time", seconds / plain, 1.0, "real time", note),
-        BenchRow("tracking[walk, search]", "x real time", seconds / search, 1.0, "real time", note),
+        BenchRow("control[walk, plain]", "x real time", seconds / plain, 1.0, "real time", note),
+        BenchRow(
+            "control[walk, search]", "x real time", seconds / searched, 1.0, "real time", note
+        ),
     ]
 
 
@@ -49,8 +51,8 @@ def _upright_row() -> BenchRow:
     for seed in seeds:
         walk = generate("walk", duration_s=seconds, fps=30.0, seed=seed)
         h = humanoid_for(walk)
-        upright["plain"] += not track(h.model, h.qpos, walk.fps).fell
-        upright["search"] += not search_track(h.model, h.qpos, walk.fps).result.fell
+        upright["plain"] += not control(h.model, h.qpos, walk.fps).fell
+        upright["search"] += not search(h.model, h.qpos, walk.fps).result.fell
     n = len(seeds)
     return BenchRow(
         "upright[walk 10 s, search]",
@@ -81,5 +83,5 @@ def _retarget_row(quick: bool) -> BenchRow:
 
 
 def run(quick: bool = False) -> list[BenchRow]:
-    """Tracking and retargeting rows; see the module docstring."""
+    """Control and retargeting rows; see the module docstring."""
     return [*_speed_rows(quick), *([] if quick else [_upright_row()]), _retarget_row(quick)]
