@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from avatar_models.body import BodyDescription, RestPoseNotUprightError, build_body, control_spec
+from avatar_models.body import BodyDescription, RestPoseNotUprightError, build_body
 from avatar_models.errors import MotionValueError
 from avatar_models.measure import standing_height
 from avatar_models.motion import Motion
@@ -75,8 +75,10 @@ class Humanoid:
 
     def control_model(self) -> mujoco.MjModel:
         """A new compiled physics-control variant of ``model``
-        (:func:`avatar_models.body.control_spec`): motors, only floor contacts."""
-        return control_spec(self.body.spec).compile()
+        (:func:`sim.control.model.control_model`): motors, only floor contacts."""
+        from sim.control.model import control_model  # sim.control builds on this module
+
+        return control_model(self.body.spec)
 
     def for_control(self) -> Humanoid:
         """This humanoid with stance feet levelled for physics control (module docstring);

@@ -33,9 +33,10 @@ def _speed_rows(quick: bool) -> list[BenchRow]:
     seconds = 1.0 if quick else 2.0  # the plain controller stays upright 2 s (tests)
     walk = generate("walk", duration_s=seconds, fps=30.0)
     h = humanoid_for(walk)
+    model = h.control_model()
     repeats = 1 if quick else 3
-    plain = best_of(lambda: control(h.model, h.qpos, walk.fps), repeats)
-    searched = best_of(lambda: search(h.model, h.qpos, walk.fps), 1)
+    plain = best_of(lambda: control(model, h.qpos, walk.fps), repeats)
+    searched = best_of(lambda: search(model, h.qpos, walk.fps), 1)
     note = f"{seconds:.0f} s walk"
     return [
         BenchRow("control[walk, plain]", "x real time", seconds / plain, 1.0, "real time", note),
@@ -51,8 +52,9 @@ def _upright_row() -> BenchRow:
     for seed in seeds:
         walk = generate("walk", duration_s=seconds, fps=30.0, seed=seed)
         h = humanoid_for(walk)
-        upright["plain"] += not control(h.model, h.qpos, walk.fps).fell
-        upright["search"] += not search(h.model, h.qpos, walk.fps).result.fell
+        model = h.control_model()
+        upright["plain"] += not control(model, h.qpos, walk.fps).fell
+        upright["search"] += not search(model, h.qpos, walk.fps).result.fell
     n = len(seeds)
     return BenchRow(
         "upright[walk 10 s, search]",

@@ -103,7 +103,9 @@ def register(app: typer.Typer) -> None:
         summary_extra = {"motion": motion, "seed": seed, "fps": m.fps}
         summary_extra |= humanoid.summary()
         search = None if plain else SearchSettings(samples=samples, beam=beam, seed=seed)
-        result, summary = timed_control(humanoid.model, qpos, m.fps, search, progress_bar=True)
+        result, summary = timed_control(
+            humanoid.control_model(), qpos, m.fps, search, progress_bar=True
+        )
         summary |= summary_extra
         wall = summary["wall_s"]
         table = Table(title=f"physics control ({summary['mode']}): {escape(motion)}")

@@ -32,7 +32,7 @@ def run(ctx: RunContext) -> None:
     reference = ctx.humanoid.for_control()
     qpos = looped(reference.qpos, fps, spec.seconds)
     search = SearchSettings() if spec.search else None
-    result, summary = timed_control(reference.model, qpos, fps, search)
+    result, summary = timed_control(reference.control_model(), qpos, fps, search)
     upright = summary["duration_s"] if result.fall_time_s is None else result.fall_time_s
     ctx.metrics |= {
         "control_fell": float(not summary["completed"]),

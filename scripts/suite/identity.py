@@ -1,7 +1,7 @@
 """What makes two runs of a scenario comparable: its hash and its seed.
 
 The hash covers what decides the measured values (motion, body, devices, methods, cameras,
-physics tracking and the ``[physics]`` check definitions), not what only judges or shows them
+physics control and the ``[physics]`` check definitions), not what only judges or shows them
 (``name``, thresholds, ``expect_fail``, ``[regression]``, ``[report]``) nor the seed, which a
 baseline compares on its own so that a message can say which of the two changed.
 """

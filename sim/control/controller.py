@@ -27,9 +27,10 @@ import mujoco
 import numpy as np
 
 from avatar_models.body17 import BODY17
+from avatar_models.errors import MotionValueError
 from sim.control import balance
 from sim.control.falls import fallen, first_fall
-from sim.control.model import BodyIndices, control_model
+from sim.control.model import BodyIndices, is_control_model
 from sim.control.qp import WholeBodyQP
 from sim.control.records import FrameRecord, Recording
 from sim.control.reference import Reference, ReferencePoint
@@ -109,13 +110,19 @@ class Progress:
 
 
 class Controller:
-    """A simulation of the humanoid ``model`` following references (module docstring), on
-    its control variant (:func:`sim.control.model.control_model`; ``model`` is not
-    changed). ``model`` and ``data`` are the simulation's, exposed for inspection."""
+    """A simulation of the humanoid following references (module docstring). ``model`` is
+    the humanoid's control variant (:func:`sim.control.model.control_model`, or
+    :meth:`sim.humanoid.Humanoid.control_model`), compiled once and only read here: several
+    controllers may share it. ``data`` is this simulation's, exposed for inspection."""
 
     def __init__(self, model: mujoco.MjModel, settings: ControlSettings | None = None):
+        if not is_control_model(model):
+            raise MotionValueError(
+                "Controller needs the humanoid's control variant (motors, floor contacts): "
+                "pass sim.control.model.control_model(spec) or Humanoid.control_model()"
+            )
         self.settings = settings or ControlSettings()
-        self.model = control_model(model)
+        self.model = model
         self.data = mujoco.MjData(self.model)
         self.body = BodyIndices.of(self.model)
         self.qp = WholeBodyQP(self.model, self.data, self.body, self.settings)
@@ -257,5 +264,6 @@ def control(
     fps: float,
     settings: ControlSettings | None = None,
 ) -> ControlResult:
-    """Follow ``qpos_ref (T, nq)`` at ``fps`` with a fresh :class:`Controller` on ``model``."""
+    """Follow ``qpos_ref (T, nq)`` at ``fps`` with a fresh :class:`Controller` on ``model``
+    (the humanoid's control variant, :func:`sim.control.model.control_model`)."""
     return Controller(model, settings).run(qpos_ref, fps)

@@ -6,43 +6,41 @@ Shapes: ``nu`` actuated hinges, ``G`` sole boxes, 8 corners each.
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 
+from avatar_models.body import control_spec
 from avatar_models.body17 import BODY17
 from avatar_models.errors import MotionValueError
 from sim.soles import ANKLE_SITES, box_corners, foot_bodies, sole_boxes, thigh_bodies
 
 
-def control_model(model: mujoco.MjModel) -> mujoco.MjModel:
-    """A copy of the humanoid ``model`` as the controller simulates it; ``model`` (e.g. a
-    Humanoid's, shared by every stage) stays as it is.
-
-    Two changes, nothing else:
-
-    * the actuators become motors: ``ctrl`` is the torque (gain 1, no bias), unclamped;
-    * only the floor collides with the body (the world's geoms collide with the body's, the
-      body's not with each other): the retargeted limbs of real clips overlap (upper arms
-      4 cm into the chest, calves crossing), and contacts between them would push with forces
-      the controller does not know of. Self-collision is a check on the reference
-      (``sim.checks.self_collision``), not something to simulate while controlling.
+def control_model(spec: mujoco.MjSpec) -> mujoco.MjModel:
+    """The humanoid as the controller simulates it, compiled from its ``spec`` (e.g.
+    :attr:`sim.humanoid.Humanoid.spec`) through :func:`avatar_models.body.control_spec`: the
+    actuators are motors (``ctrl`` is the torque) and only the floor collides with the body.
+    ``spec`` is not changed.
 
     Raises :class:`MotionValueError` unless every actuator drives a hinge (none the root).
     """
+    model = control_spec(spec).compile()
     if model.nu == 0 or np.any(model.jnt_type[model.actuator_trnid[:, 0]] == 0):
         raise MotionValueError("control needs hinge actuators and no actuator on the root")
-    model = copy.copy(model)
-    model.actuator_gainprm[:] = 0.0
-    model.actuator_gainprm[:, 0] = 1.0
-    model.actuator_biasprm[:] = 0.0
-    model.actuator_ctrllimited[:] = 0
-    world = model.geom_bodyid == 0
-    model.geom_contype[:] = np.where(world, 0, 1)
-    model.geom_conaffinity[:] = np.where(world, 1, 0)
     return model
+
+
+def is_control_model(model: mujoco.MjModel) -> bool:
+    """Whether ``model``'s actuators are motors (unit gain, no bias, no clamp), as
+    :func:`control_model` makes them."""
+    gain = np.zeros_like(model.actuator_gainprm)
+    gain[:, 0] = 1.0
+    return bool(
+        np.array_equal(model.actuator_gainprm, gain)
+        and not model.actuator_biasprm.any()
+        and not model.actuator_ctrllimited.any()
+    )
 
 
 @dataclass(frozen=True)

@@ -14,9 +14,9 @@ import json
 import numpy as np
 
 from avatar_models.body import build_body
-from avatar_models.body.ik import humanoid_model
 from avatar_models.generator import generate, sample_subject
 from sim.control.controller import control
+from sim.control.model import control_model
 
 
 def main() -> None:
@@ -25,7 +25,7 @@ def main() -> None:
     for subject, seed in cases:
         walk = generate("walk", subject, duration_s=2.0, fps=30.0, seed=seed)
         body = build_body(walk.skeleton)
-        r = control(humanoid_model(body), body.qpos_from_motion(walk), walk.fps)
+        r = control(control_model(body.spec), body.qpos_from_motion(walk), walk.fps)
         e = 100 * r.body17_error.mean(axis=1)
         row = {
             "height_m": None if subject is None else round(subject.height_m, 2),

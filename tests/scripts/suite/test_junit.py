@@ -25,10 +25,10 @@ XSD = Path(__file__).resolve().parents[2] / "data" / "jenkins-junit.xsd"
         ("residual_force_bw_p95", "x body weight"),
         ("joint_limit_violation_frac", "fraction"),
         ("coolmoves_hand_corr_min", "Pearson r"),
-        ("tracking_upright_s", "s"),
+        ("control_upright_s", "s"),
         ("kinect_fps_rendered", "frames/s"),
         ("frames", ""),
-        ("tracking_fell", ""),
+        ("control_fell", ""),
     ],
 )
 def test_units_come_from_the_metric_names(name, unit):

@@ -26,12 +26,12 @@ from tests.scripts.suite.conftest import write_scenario
         ("replay_error_mm_max", "accuracy"),
         ("ik_hand_corr_min", "rate"),
         ("vr_valid_frac", "rate"),
-        ("tracking_fell", "rate"),
+        ("control_fell", "rate"),
         ("skate_cm_s_median", "physics"),
-        ("tracking_upright_s", "physics"),
+        ("control_upright_s", "physics"),
         ("frames", None),
         ("fisheye_fps_rendered", None),
-        ("tracking_x_real_time", None),
+        ("control_x_real_time", None),
     ],
 )
 def test_metric_kinds(name, kind):

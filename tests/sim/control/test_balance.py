@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from avatar_models.body import build_body
-from avatar_models.body.ik import humanoid_model
 from avatar_models.rigs import load_rig
 from sim.control.balance import clock_rate, reference_stance, step_shift, swing_weights
 from sim.control.controller import control
+from sim.control.model import control_model
 from sim.control.settings import ControlSettings
 
 
@@ -23,11 +23,11 @@ def test_reference_clock_follows_the_capture_point(body):
     """A reference standing 5 cm ahead: the body leans after it, its capture point leads, so
     the adaptive clock plays the reference faster than real time; without clock feedback the
     reference plays at real time."""
-    model = humanoid_model(body)
+    model = control_model(body.spec)
     ahead = np.tile(model.qpos0, (31, 1))
     ahead[1:, 0] += 0.05
     adaptive = control(model, ahead, 30.0).reference_frame
-    fixed = control(humanoid_model(body), ahead, 30.0, ControlSettings(clock_gain=0.0))
+    fixed = control(control_model(body.spec), ahead, 30.0, ControlSettings(clock_gain=0.0))
     step = model.opt.timestep * 30.0  # frames are sampled at the first step past them
     np.testing.assert_allclose(fixed.reference_frame, np.arange(31), atol=step + 1e-9)
     assert np.all(np.diff(adaptive[:20]) > 1.0)

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 from avatar_models.body import build_body
-from avatar_models.body.ik import humanoid_model
 from avatar_models.errors import MotionValueError
 from avatar_models.generator import generate, sample_subject
 from avatar_models.rigs import load_rig
 from sim.control.controller import Controller, ControlResult, control
+from sim.control.model import control_model
 from sim.control.settings import ControlSettings
 
 BANDAI_WALK = "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh"
@@ -47,7 +47,7 @@ def summary_line(name: str, result: ControlResult) -> None:
 
 
 def test_root_is_unactuated_while_walking(body):
-    model = humanoid_model(body)
+    model = control_model(body.spec)
     free = np.flatnonzero(model.jnt_type == 0)
     assert free.tolist() == [0]
     assert not np.isin(model.actuator_trnid[:, 0], free).any()
@@ -75,10 +75,9 @@ def newton_residual_bw(body, seconds: float, push_bw: float = 0.0, seed: int = 0
     """``(steps - 1,)`` |d(m v_com)/dt - (floor forces + m g)| / body weight at each step of a
     built-in walk the controller follows. ``push_bw`` lifts the root by that share of the body
     weight through ``xfrc_applied`` (a hidden force the residual must show)."""
-    model = humanoid_model(body)
+    model = control_model(body.spec)
     walk = generate("walk", duration_s=seconds, fps=30.0, seed=seed)
     controller = Controller(model)
-    model = controller.model  # the controller's own copy: motors, floor-only contacts
     ref = controller.reference(body.qpos_from_motion(walk), walk.fps)
     progress = controller.start(ref)
     data, probe = controller.data, mujoco.MjData(model)
@@ -115,7 +114,7 @@ def test_nothing_but_the_floor_and_gravity_holds_the_body_up(body):
     0.5-0.6 %, max 2.0-2.8 % of body weight per step (finite differencing across the
     implicit integrator's step), while floor forces reach 4 body weights. Bounds: twice the
     worst measured. A hidden lift of 10 % of body weight on the root is caught."""
-    model = humanoid_model(body)
+    model = control_model(body.spec)
     assert model.neq == 0  # no equality constraint (weld, connect) to the world
     assert not model.body_gravcomp.any()
     np.testing.assert_array_equal(model.opt.gravity, [0.0, 0.0, -9.81])
@@ -131,7 +130,7 @@ def test_nothing_but_the_floor_and_gravity_holds_the_body_up(body):
 
 
 def test_standing_still_holds_for_2_s(body):
-    model = humanoid_model(body)
+    model = control_model(body.spec)
     result = control(model, np.tile(model.qpos0, (61, 1)), 30.0)
     assert not result.fell
     assert result.body17_error.mean() < 0.01  # metres
@@ -156,7 +155,7 @@ def test_plain_controller_follows_the_first_second_of_a_walk(subject, seed):
     people = [sample_subject(rng) for _ in range(8)]
     walk = generate("walk", None if subject is None else people[subject], 2.0, 30.0, seed)
     walk_body = build_body(walk.skeleton)
-    controller = Controller(humanoid_model(walk_body))
+    controller = Controller(control_model(walk_body.spec))
     ref = controller.reference(walk_body.qpos_from_motion(walk), walk.fps)
     one_second = int(round(1.0 / controller.model.opt.timestep))
     progress = controller.advance(ref, controller.start(ref), one_second)
@@ -170,12 +169,12 @@ def test_open_loop_body_falls_and_is_detected(body):
     """Torques computed once and never updated cannot balance a walk."""
     walk = generate("walk", duration_s=3.0, fps=30.0)
     blind = ControlSettings(control_period=10**9)
-    result = control(humanoid_model(body), body.qpos_from_motion(walk), walk.fps, blind)
+    result = control(control_model(body.spec), body.qpos_from_motion(walk), walk.fps, blind)
     assert result.fell and 0.0 < result.fall_time_s < 3.0
 
 
 def test_bad_reference_is_refused(body):
-    model = humanoid_model(body)
+    model = control_model(body.spec)
     with pytest.raises(MotionValueError, match="reference must"):
         control(model, np.full((3, model.nq), np.nan), 30.0)
     with pytest.raises(MotionValueError, match="at least 2 frames"):
@@ -186,7 +185,7 @@ def test_a_diverging_simulation_counts_as_a_fall(body):
     """Absurd gains make MuJoCo's accelerations diverge; it then resets the state to the rest
     pose and goes on, which must not pass for control."""
     walk = generate("walk", duration_s=1.0, fps=30.0)
-    controller = Controller(humanoid_model(body), ControlSettings(kp=1e6, kd=2e3))
+    controller = Controller(control_model(body.spec), ControlSettings(kp=1e6, kd=2e3))
     result = controller.run(body.qpos_from_motion(walk), walk.fps)
     assert controller.unstable()
     assert result.fall_frame == 1
@@ -197,8 +196,8 @@ def test_a_run_advanced_in_pieces_equals_one_run(body):
     windows of 37 steps records exactly what one uninterrupted run records."""
     walk = generate("walk", duration_s=0.6, fps=30.0)
     qpos = body.qpos_from_motion(walk)
-    whole = control(humanoid_model(body), qpos, walk.fps)
-    controller = Controller(humanoid_model(body))
+    whole = control(control_model(body.spec), qpos, walk.fps)
+    controller = Controller(control_model(body.spec))
     ref = controller.reference(qpos, walk.fps)
     progress = controller.start(ref)
     while not controller.finished(ref, progress):

@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 
 from avatar_models.body import build_body
-from avatar_models.body.ik import humanoid_model
 from avatar_models.rigs import load_rig
 from sim.control.controller import control
 from sim.control.falls import HEAD, fallen, first_fall, tilt_deg
+from sim.control.model import control_model
 from sim.control.settings import ControlSettings
 
 UPRIGHT = np.array([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0])
@@ -41,7 +41,7 @@ def test_each_criterion_alone_is_a_fall():
 def test_a_body_left_behind_by_its_reference_is_lost():
     """The reference stands, then jumps 1 m sideways: the humanoid stays up but is lost
     (mean body17 distance over 0.5 m) from the jump on."""
-    model = humanoid_model(build_body(load_rig("avatar").skeleton))
+    model = control_model(build_body(load_rig("avatar").skeleton).spec)
     jumped = np.tile(model.qpos0, (31, 1))
     jumped[15:, 1] += 1.0
     result = control(model, jumped, 30.0)

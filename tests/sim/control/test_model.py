@@ -1,5 +1,5 @@
-"""The control model: motors, floor-only collisions, the caller's model unchanged; a model
-the controller cannot drive is refused."""
+"""The control model: compiled from the spec with motors and floor-only collisions, the
+spec and its own model unchanged; a model the controller cannot drive is refused."""
 
 from __future__ import annotations
 
@@ -8,22 +8,24 @@ import numpy as np
 import pytest
 
 from avatar_models.body import build_body
-from avatar_models.body.ik import humanoid_model
 from avatar_models.errors import MotionValueError
 from avatar_models.rigs import load_rig
-from sim.control.model import BodyIndices, control_model
+from sim.control.controller import Controller
+from sim.control.model import BodyIndices, control_model, is_control_model
 
 
 @pytest.fixture(scope="module")
-def model():
-    return humanoid_model(build_body(load_rig("avatar").skeleton))
+def body():
+    return build_body(load_rig("avatar").skeleton)
 
 
-def test_control_model_has_motors_and_floor_only_contacts(model):
+def test_control_model_has_motors_and_floor_only_contacts(body):
+    model = body.model
     before = (model.actuator_gainprm.copy(), model.geom_contype.copy())
-    controlled = control_model(model)
-    np.testing.assert_array_equal(model.actuator_gainprm, before[0])  # the caller's model
+    controlled = control_model(body.spec)
+    np.testing.assert_array_equal(model.actuator_gainprm, before[0])  # the body's own model
     np.testing.assert_array_equal(model.geom_contype, before[1])
+    assert is_control_model(controlled) and not is_control_model(model)
     data = mujoco.MjData(controlled)
     data.ctrl[:] = 7.0
     mujoco.mj_forward(controlled, data)
@@ -34,12 +36,17 @@ def test_control_model_has_motors_and_floor_only_contacts(model):
     assert (controlled.geom_conaffinity[world] & controlled.geom_contype[~world][:, None]).all()
 
 
-def test_body_indices_find_feet_hips_and_soles(model):
-    body = BodyIndices.of(control_model(model))
-    assert body.sites.shape == (17,) and (body.sites >= 0).all()
-    assert len(body.feet) == 2 and len(body.hip_dof) == 2
-    assert body.sole_corners.shape == (body.sole_geoms.size, 8, 3)
-    for normal in body.sole_normal:
+def test_the_controller_refuses_a_model_with_position_servos(body):
+    with pytest.raises(MotionValueError, match="control variant"):
+        Controller(body.model)
+
+
+def test_body_indices_find_feet_hips_and_soles(body):
+    indices = BodyIndices.of(control_model(body.spec))
+    assert indices.sites.shape == (17,) and (indices.sites >= 0).all()
+    assert len(indices.feet) == 2 and len(indices.hip_dof) == 2
+    assert indices.sole_corners.shape == (indices.sole_geoms.size, 8, 3)
+    for normal in indices.sole_normal:
         assert np.linalg.norm(normal) == pytest.approx(1.0)
 
 
@@ -49,4 +56,4 @@ def test_a_model_with_an_actuated_root_is_refused():
         '</worldbody><actuator><motor joint="root"/></actuator></mujoco>'
     )
     with pytest.raises(MotionValueError, match="no actuator on the root"):
-        control_model(spec.compile())
+        control_model(spec)

@@ -10,11 +10,11 @@ from scipy.spatial.transform import Rotation
 
 from avatar_models import quat
 from avatar_models.body import build_body
-from avatar_models.body.ik import humanoid_model
 from avatar_models.generator import generate, sample_subject
 from avatar_models.motion import Motion
 from avatar_models.rigs import load_rig
 from sim.control.controller import Controller, ControlResult, control
+from sim.control.model import control_model
 from sim.soles import foot_bodies
 
 
@@ -26,7 +26,7 @@ def _leaning(body, degrees: float, frames: int = 61) -> Motion:
     rot[..., 0] = 1.0
     root_rest = np.array([0.0, 0.0, body.root_height])
     rest = Motion(sk, 30.0, np.tile(root_rest, (frames, 1)), rot.copy())
-    feet = foot_bodies(humanoid_model(body))
+    feet = foot_bodies(control_model(body.spec))
     foot_rest = rest.global_positions()[0, sk.index(feet[0])]
     lean = Rotation.from_euler("y", degrees, degrees=True)
     rot[:, 0] = quat.from_scipy(lean)
@@ -65,7 +65,7 @@ def ankle_balance(body, degrees: float) -> tuple[ControlResult, dict[int, tuple[
     """Hold ``body`` leaning ``degrees`` forward; the result and, at frames 40, 50 and 60, the
     (demanded, supplied) moment about the ankle line (N m): the weight of the body without its
     feet about that line, and the ankle actuators' torques about it."""
-    model = humanoid_model(body)
+    model = control_model(body.spec)
     result = control(model, body.qpos_from_motion(_leaning(body, degrees)), 30.0)
     data = mujoco.MjData(model)
     feet = [model.body(name).id for name in foot_bodies(model)]
@@ -91,7 +91,7 @@ def ankle_balance(body, degrees: float) -> tuple[ControlResult, dict[int, tuple[
 def test_contacts_are_the_sole_corners_on_the_floor():
     """Standing flat, 1 mm into the floor: the 4 bottom corners of every sole box touch, 4
     pyramid edges each; lifted 10 cm: no contact is offered."""
-    model = humanoid_model(build_body(load_rig("avatar").skeleton))
+    model = control_model(build_body(load_rig("avatar").skeleton).spec)
     controller = Controller(model)
     d = controller.data
     d.qpos[:] = controller.model.qpos0  # standing on the floor

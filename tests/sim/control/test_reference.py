@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from avatar_models.body import build_body
-from avatar_models.body.ik import humanoid_model
 from avatar_models.errors import MotionValueError
 from avatar_models.generator import generate
 from avatar_models.rigs import load_rig
 from sim.control.controller import Controller
+from sim.control.model import control_model
 from sim.control.reference import looped
 
 
@@ -24,7 +24,7 @@ def body():
 @pytest.fixture(scope="module")
 def walk_reference(body):
     walk = generate("walk", duration_s=1.0, fps=30.0)
-    return Controller(humanoid_model(body)).reference(body.qpos_from_motion(walk), walk.fps)
+    return Controller(control_model(body.spec)).reference(body.qpos_from_motion(walk), walk.fps)
 
 
 def test_reference_at_a_frame_is_that_frame(walk_reference):
@@ -56,7 +56,7 @@ def test_reference_between_frames_is_linear_and_held_past_the_end(walk_reference
 
 
 def test_clip_too_short_to_loop_is_refused(body):
-    model = humanoid_model(body)
+    model = control_model(body.spec)
     with pytest.raises(MotionValueError, match="too short to loop"):
         looped(np.tile(model.qpos0, (2, 1)), 30.0, 5.0)
 

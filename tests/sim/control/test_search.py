@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from avatar_models.body import build_body
-from avatar_models.body.ik import humanoid_model
 from avatar_models.generator import generate
 from avatar_models.rigs import load_rig
 from sim.control.controller import Controller
+from sim.control.model import control_model
 from sim.control.reference import looped
 from sim.control.search import Beam, Node, SearchSettings, replay, search, state_cost
 from tests.sim.control.test_controller import BANDAI_WALK, RootWatch, summary_line
@@ -26,13 +26,13 @@ def body():
 def test_search_walks_and_its_path_replays_exactly_without_root_forces(body):
     walk = generate("walk", duration_s=3.0, fps=30.0, seed=0)
     qpos = body.qpos_from_motion(walk)
-    searched = search(humanoid_model(body), qpos, walk.fps)
+    searched = search(control_model(body.spec), qpos, walk.fps)
     assert not searched.result.fell, searched.result.summary()
-    assert searched.offsets.shape == (15, humanoid_model(body).nu)  # 3 s in 0.2 s windows
+    assert searched.offsets.shape == (15, control_model(body.spec).nu)  # 3 s in 0.2 s windows
     assert np.any(searched.offsets)  # some window chose a sampled offset
     assert searched.simulated_s >= 2 * 8 * 3.0  # 8 samples per state, each with a look-ahead
     again = replay(
-        RootWatch(humanoid_model(body)), qpos, walk.fps, searched.offsets, searched.window_steps
+        RootWatch(control_model(body.spec)), qpos, walk.fps, searched.offsets, searched.window_steps
     )
     np.testing.assert_array_equal(again.qpos, searched.result.qpos)
 
@@ -40,7 +40,7 @@ def test_search_walks_and_its_path_replays_exactly_without_root_forces(body):
 def test_cost_is_zero_on_the_reference_and_infinite_once_fallen(body):
     walk = generate("walk", duration_s=1.0, fps=30.0, seed=0)
     qpos = body.qpos_from_motion(walk)
-    controller = Controller(humanoid_model(body))
+    controller = Controller(control_model(body.spec))
     ref = controller.reference(qpos, walk.fps)
     progress = controller.start(ref)  # the humanoid is on the reference's first frame
     settings = SearchSettings()
@@ -56,7 +56,7 @@ def test_cost_is_zero_on_the_reference_and_infinite_once_fallen(body):
 @pytest.mark.parametrize("seed", [0, 1, 2, 3])
 def test_searched_walk_10_s_without_falling(body, seed):
     walk = generate("walk", duration_s=10.0, fps=30.0, seed=seed)
-    searched = search(humanoid_model(body), body.qpos_from_motion(walk), walk.fps)
+    searched = search(control_model(body.spec), body.qpos_from_motion(walk), walk.fps)
     summary_line(f"searched builtin walk seed {seed}", searched.result)
     assert not searched.result.fell
 
@@ -69,7 +69,7 @@ def test_searched_bandai_walk_10_s_without_falling(mocap_dir):
 
     walk = retarget(load_motion(mocap_dir / BANDAI_WALK), level_feet=True)
     qpos = looped(walk.qpos, walk.motion.fps, 10.0)
-    model = humanoid_model(build_body(walk.motion.skeleton))
+    model = control_model(build_body(walk.motion.skeleton).spec)
     searched = search(model, qpos, walk.motion.fps)
     summary_line("searched bandai walk", searched.result)
     assert not searched.result.fell
@@ -82,7 +82,7 @@ def test_search_stops_at_its_budget_upright_and_incomplete(body):
     6 x 8 x 0.4 = 19.2 s, which spends 1 s of reference's 5 s; the third never starts."""
     walk = generate("walk", duration_s=1.0, fps=30.0, seed=0)
     searched = search(
-        humanoid_model(body),
+        control_model(body.spec),
         body.qpos_from_motion(walk),
         walk.fps,
         search_settings=SearchSettings(budget=5.0),
