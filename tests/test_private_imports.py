@@ -6,18 +6,11 @@ from pathlib import Path
 from tests.private_names import PrivateUse, private_uses, private_uses_in
 
 PACKAGES = ("avatar_models", "render_cams", "synthesis", "sim", "scripts")
-# Known uses owned by other work of issue 10 (``path: what``); remove each when it is fixed.
-KNOWN = {
-    "sim/sampling.py: from sim.tracking import _up",
-    "tests/avatar_models/test_bvh.py: from avatar_models.formats.bvh import _motion_values",
-    "tests/avatar_models/test_bvh.py: from avatar_models.formats.bvh import _checked_motion_values",
-}
 
 
 def test_no_module_or_test_uses_another_modules_private_name():
     found = private_uses(PACKAGES, extra_folders=("tests",))
-    new = [str(use) for use in found if use.key not in KNOWN]
-    assert not new, "private names used across modules:\n" + "\n".join(new)
+    assert not found, "private names used across modules:\n" + "\n".join(map(str, found))
 
 
 def test_the_check_finds_each_kind_of_private_use(tmp_path):
