@@ -54,7 +54,13 @@ def register(app: typer.Typer) -> None:
     @app.command(name="eval")
     @user_errors
     def eval_(
-        method: Annotated[str, typer.Argument(help="coolmoves or coolmoves-gmm.")],
+        method: Annotated[
+            str,
+            typer.Argument(
+                help="coolmoves (the paper's), coolmoves+arm-ik, coolmoves-gmm, "
+                "coolmoves-centroid-align (synthesis.methods)."
+            ),
+        ],
         library: Annotated[
             str, typer.Option(help="'builtin' (generator) or a mocap folder (Bandai, CMU).")
         ] = "builtin",
@@ -87,7 +93,7 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Accuracy protocols of a synthesis method, IK baseline beside (CoolMoves §4.1)."""
         from synthesis.evaluate import (
-            METHODS,
+            EVALUABLE,
             PROTOCOLS,
             EvaluationError,
             builtin_trials,
@@ -107,8 +113,8 @@ def register(app: typer.Typer) -> None:
             if not lo <= value <= hi:  # also NaN
                 raise EvaluationError(f"{option} must be {lo:g}-{hi:g}, got {value}")
         check_outputs(json_out=json_out, out=out)
-        if method not in METHODS:
-            raise EvaluationError(f"unknown method {method!r}; available: {', '.join(METHODS)}")
+        if method not in EVALUABLE:
+            raise EvaluationError(f"unknown method {method!r}; available: {', '.join(EVALUABLE)}")
         if protocol not in PROTOCOLS:
             raise EvaluationError(f"unknown protocol {protocol!r}; use {' or '.join(PROTOCOLS)}")
         wanted = None if classes is None else [c.strip() for c in classes.split(",") if c.strip()]

@@ -10,7 +10,7 @@ database) and :mod:`.protocol` (running and aggregating them). Scoring a run is
 from synthesis.evaluate.folds import PROTOCOLS, Fold, database_for, folds
 from synthesis.evaluate.protocol import (
     ABLATION,
-    METHODS,
+    EVALUABLE,
     PAPER,
     evaluate_fold,
     ik_baseline_for,
@@ -29,7 +29,7 @@ from synthesis.evaluate.trials import (
 
 __all__ = [
     "ABLATION",
-    "METHODS",
+    "EVALUABLE",
     "PAPER",
     "PAPER_ACTIVITIES",
     "PROTOCOLS",

@@ -24,20 +24,16 @@ from avatar_models.measure import standing_height
 from avatar_models.rigs import load_rig
 from render_cams import VRSetup
 from synthesis.base import SynthesisError
-from synthesis.coolmoves import CoolMoves, Database, Options
+from synthesis.coolmoves import CoolMoves, Database
 from synthesis.evaluate.folds import Fold, database_for, folds
 from synthesis.evaluate.trials import EvaluationError, Trial, turned
 from synthesis.ik_baseline import IKBaseline
+from synthesis.methods import METHODS, Method
 from synthesis.scoring import GROUPS, score_run
 
-METHODS: dict[str, Options] = {
-    "coolmoves": Options(),
-    "coolmoves-gmm": Options(matcher="gmm"),
-    "coolmoves-centroid-align": Options(align_about_centroid=True),
-}
-"""Evaluable methods and their options (the GMM variant is the paper's slower alternative;
-``coolmoves-centroid-align`` aligns with the paper's printed equation, see
-:mod:`synthesis.coolmoves.alignment`)."""
+EVALUABLE = tuple(name for name, m in METHODS.items() if m.options is not None)
+"""The registered methods this protocol evaluates (the CoolMoves variants, the IK baseline
+beside each; every registered method side by side is the leaderboard)."""
 ABLATION: dict[str, dict[str, bool]] = {
     "no_alignment_no_smoothing": {"align": False, "smooth": False},
     "alignment_no_smoothing": {"align": True, "smooth": False},
@@ -71,14 +67,15 @@ def ik_baseline_for(database: Database, truth: Motion, setup: VRSetup) -> IKBase
 
 def evaluate_fold(
     fold: Fold,
-    options: Options,
+    method: Method,
     setup: VRSetup,
     ablation: bool = True,
     baseline_cache: dict | None = None,
     heading_deg: float = 0.0,
     db_headings: int = 1,
 ) -> list[dict]:
-    """Per test trial of ``fold``: the method, its ablation variants and the IK baseline.
+    """Per test trial of ``fold``: the CoolMoves variant ``method``, its ablation variants
+    (switched from the variant's options) and the IK baseline.
 
     ``heading_deg``: turn each test motion by a random yaw up to this (:func:`turned`);
     ``db_headings``: turned copies of the database (:func:`database_for`).
@@ -91,6 +88,7 @@ def evaluate_fold(
         stream = setup.sample(truth, seed=trial.seed)
         height = standing_height(truth)
         row = {"trial": trial.name, "cls": trial.cls, "held_out": fold.held_out}
+        options = method.options
         row["method"] = score_run(CoolMoves(database, height, options), truth, stream).row()
         if ablation:
             row["ablation"] = {
@@ -173,8 +171,8 @@ def run_protocol(
     test motion by a random yaw up to this (the database keeps its headings);
     ``db_headings > 1`` adds turned copies to each fold's database (:func:`database_for`).
     """
-    if method not in METHODS:
-        raise EvaluationError(f"unknown method {method!r}; available: {', '.join(METHODS)}")
+    if method not in EVALUABLE:
+        raise EvaluationError(f"unknown method {method!r}; available: {', '.join(EVALUABLE)}")
     if not trials:
         raise EvaluationError("no trials to evaluate")
     all_folds, skipped = folds(trials, protocol)
