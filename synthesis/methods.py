@@ -34,7 +34,9 @@ class MethodInputs:
         rig: the rig the ground truth is scored on (the humanoid's: the truth's own rig, or
             the avatar rig a foreign rig was retargeted onto); the IK baseline drives it.
         calibration: device-on-joint attachments (hmd, left, right controller) on ``rig``,
-            or None for the nominal ones.
+            or None for the nominal ones; a calibration from another rig
+            (:func:`~synthesis.ik_baseline.attachments_on_upright_rig`) is steered by
+            position only (the rigs' hand frames differ).
         coolmoves: option overrides for every CoolMoves variant (e.g. a scenario's
             ``foot_contact``), applied on top of the variant's own.
     """
@@ -77,7 +79,8 @@ def coolmoves(name: str, summary: str, options: Options) -> Method:
 
 def ik_baseline(inputs: MethodInputs) -> Synthesizer:
     """The VRIK-like baseline on the scored rig (:class:`~synthesis.ik_baseline.IKBaseline`)."""
-    return IKBaseline(inputs.rig, inputs.user_height_m, inputs.calibration)
+    own = inputs.calibration is None
+    return IKBaseline(inputs.rig, inputs.user_height_m, inputs.calibration, own)
 
 
 METHODS: dict[str, Method] = {

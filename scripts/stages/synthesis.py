@@ -8,6 +8,7 @@ import numpy as np
 from avatar_models.generator import generate_library
 from avatar_models.measure import standing_height
 from avatar_models.motion import Motion
+from render_cams.vr import HEADSET_AND_CONTROLLERS, Attachment
 from scripts.method_score import score_method
 from scripts.run_context import RunContext
 from scripts.scenario import Scenario, ScenarioError
@@ -15,6 +16,7 @@ from scripts.stages.physics import config as physics_config
 from sim.humanoid import Humanoid
 from synthesis.base import Synthesizer
 from synthesis.coolmoves import build_database
+from synthesis.ik_baseline import attachments_on_upright_rig
 from synthesis.methods import METHODS, MethodInputs, build
 from synthesis.scoring import GROUPS
 
@@ -55,6 +57,17 @@ def database_takes(ctx: RunContext) -> list[Motion]:
     )
 
 
+def ik_calibration(ctx: RunContext) -> list[Attachment] | None:
+    """The VR devices' attachments on the humanoid's rig: None (the nominal ones) for the
+    truth's own rig; on a rig retargeted from a foreign one, the attachments the stream was
+    sampled with, turned into the upright rig's joint frames."""
+    if not ctx.humanoid.retargeted:
+        return None
+    offsets = ctx.vr_stream.meta["offsets"]
+    measured = [Attachment(**offsets[device]) for device in HEADSET_AND_CONTROLLERS]
+    return attachments_on_upright_rig(measured, ctx.motion.skeleton)
+
+
 def method_inputs(ctx: RunContext, user_height_m: float) -> MethodInputs:
     """The registry's inputs for this scenario: a database of :func:`database_takes` (built
     once, for every CoolMoves variant), and the humanoid's rig (the ground truth's own, or the
@@ -64,6 +77,7 @@ def method_inputs(ctx: RunContext, user_height_m: float) -> MethodInputs:
         database_factory=lambda: build_database(database_takes(ctx)),
         user_height_m=user_height_m,
         rig=ctx.humanoid.body.skeleton,
+        calibration=ik_calibration(ctx),
         coolmoves={"foot_contact": ctx.scenario.synthesis.foot_contact},
     )
 

@@ -27,7 +27,7 @@ from synthesis.base import SynthesisError
 from synthesis.coolmoves import CoolMoves, Database
 from synthesis.evaluate.folds import Fold, database_for, folds
 from synthesis.evaluate.trials import EvaluationError, Trial, turned
-from synthesis.ik_baseline import IKBaseline
+from synthesis.ik_baseline import IKBaseline, attachments_on_upright_rig
 from synthesis.methods import METHODS, Method
 from synthesis.scoring import GROUPS, score_run
 
@@ -56,12 +56,14 @@ PAPER = {
 def ik_baseline_for(database: Database, truth: Motion, setup: VRSetup) -> IKBaseline:
     """The IK baseline on the database's rig (the method's output rig); a rig whose rest pose
     does not stand (Bandai's) falls back to the avatar rig, calibrated with the true device
-    offsets (positions only, its joint frames differ)."""
+    attachments turned into its upright joint frames (:func:`attachments_on_upright_rig`;
+    positions only are steered: the rigs' hand frames still differ)."""
     height = standing_height(truth)
     try:
         return IKBaseline(database.skeleton, height)
     except BodyError:
-        calibration = setup.attachments(truth, np.random.default_rng(0))
+        measured = setup.attachments(truth, np.random.default_rng(0))
+        calibration = attachments_on_upright_rig(measured, truth.skeleton)
         return IKBaseline(load_rig("avatar").skeleton, height, calibration, False)
 
 
