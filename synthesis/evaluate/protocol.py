@@ -27,6 +27,7 @@ from synthesis.base import SynthesisError
 from synthesis.coolmoves import CoolMoves, Database
 from synthesis.evaluate.folds import Fold, database_for, folds
 from synthesis.evaluate.trials import EvaluationError, Trial, turned
+from synthesis.evaluate.validation import choose_max_distance
 from synthesis.ik_baseline import IKBaseline, attachments_on_upright_rig
 from synthesis.methods import METHODS, Method
 from synthesis.scoring import GROUPS, score_run
@@ -75,13 +76,20 @@ def evaluate_fold(
     baseline_cache: dict | None = None,
     heading_deg: float = 0.0,
     db_headings: int = 1,
+    tune: bool = True,
 ) -> list[dict]:
     """Per test trial of ``fold``: the CoolMoves variant ``method``, its ablation variants
     (switched from the variant's options) and the IK baseline.
 
     ``heading_deg``: turn each test motion by a random yaw up to this (:func:`turned`);
-    ``db_headings``: turned copies of the database (:func:`database_for`).
+    ``db_headings``: turned copies of the database (:func:`database_for`); ``tune``: the
+    distance threshold chosen on the fold's training data
+    (:func:`~synthesis.evaluate.validation.choose_max_distance`; each row records it).
     """
+    options = method.options
+    if tune:
+        chosen = choose_max_distance(fold.train, fold.protocol, options, setup)
+        options = replace(options, max_distance=chosen)
     database = database_for(fold.train, db_headings)
     cache = {} if baseline_cache is None else baseline_cache
     rows = []
@@ -90,7 +98,7 @@ def evaluate_fold(
         stream = setup.sample(truth, seed=trial.seed)
         height = standing_height(truth)
         row = {"trial": trial.name, "cls": trial.cls, "held_out": fold.held_out}
-        options = method.options
+        row["max_distance"] = options.max_distance
         row["method"] = score_run(CoolMoves(database, height, options), truth, stream).row()
         if ablation:
             row["ablation"] = {
@@ -133,6 +141,8 @@ def summarise(rows: Sequence[dict]) -> dict:
         "baseline_frames_per_s": rate("baseline"),
         "trials": len(rows),
     }
+    if all("max_distance" in r for r in rows):
+        out["max_distance_mean"] = mean(lambda r: r["max_distance"])
     if all("ablation" in r for r in rows):
         out["ablation_full_cm"] = {k: mean(lambda r, k=k: r["ablation"][k]) for k in ABLATION}
     return out
@@ -162,6 +172,7 @@ def run_protocol(
     progress: Callable[[int, int, str], None] | None = None,
     heading_deg: float = 0.0,
     db_headings: int = 1,
+    tune: bool = True,
 ) -> dict:
     """Evaluate ``method`` on ``trials`` under ``protocol``.
 
@@ -171,7 +182,8 @@ def run_protocol(
     ``frames_per_s`` and ``baseline_frames_per_s``, ``ablation_full_cm``, ``trials``.
     ``progress(done, total, label)`` is called after every fold. ``heading_deg`` turns each
     test motion by a random yaw up to this (the database keeps its headings);
-    ``db_headings > 1`` adds turned copies to each fold's database (:func:`database_for`).
+    ``db_headings > 1`` adds turned copies to each fold's database (:func:`database_for`);
+    ``tune`` chooses the distance threshold per fold on its training data.
     """
     if method not in EVALUABLE:
         raise EvaluationError(f"unknown method {method!r}; available: {', '.join(EVALUABLE)}")
@@ -186,7 +198,7 @@ def run_protocol(
         try:
             rows.extend(
                 evaluate_fold(
-                    fold, METHODS[method], setup, ablation, cache, heading_deg, db_headings
+                    fold, METHODS[method], setup, ablation, cache, heading_deg, db_headings, tune
                 )
             )
         except SynthesisError as exc:  # e.g. every training clip fails the correlation filter
