@@ -136,6 +136,13 @@ def rest_body_frame(skeleton: Skeleton) -> np.ndarray:
     return np.stack([np.cross(left, up), left, up], axis=1)
 
 
+def stands_upright(skeleton: Skeleton) -> bool:
+    """Whether ``skeleton``'s rest pose stands (its trunk within 25 deg of +Z, facing within
+    25 deg of +X): its joint frames are then those the IK's heading and lean assume."""
+    frame = rest_body_frame(skeleton)
+    return bool(frame[2, 2] > np.cos(np.radians(25.0)) and frame[0, 0] > np.cos(np.radians(25.0)))
+
+
 def attachments_on_upright_rig(
     attachments: Sequence[Attachment], source: Skeleton
 ) -> list[Attachment]:

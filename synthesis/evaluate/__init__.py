@@ -14,6 +14,7 @@ from synthesis.evaluate.protocol import (
     PAPER,
     evaluate_fold,
     ik_baseline_for,
+    ik_rig_for,
     run_protocol,
     summarise,
 )
@@ -42,6 +43,7 @@ __all__ = [
     "evaluate_fold",
     "folds",
     "ik_baseline_for",
+    "ik_rig_for",
     "library_trials",
     "run_protocol",
     "summarise",

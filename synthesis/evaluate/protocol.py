@@ -18,17 +18,17 @@ from dataclasses import replace
 
 import numpy as np
 
-from avatar_models import Motion
-from avatar_models.body import BodyError
+from avatar_models import Motion, Skeleton
 from avatar_models.measure import standing_height
 from avatar_models.rigs import load_rig
 from render_cams import VRSetup
+from render_cams.vr import Attachment
 from synthesis.base import SynthesisError
 from synthesis.coolmoves import CoolMoves, Database
 from synthesis.evaluate.folds import Fold, database_for, folds
 from synthesis.evaluate.trials import EvaluationError, Trial, turned
 from synthesis.evaluate.validation import choose_max_distance
-from synthesis.ik_baseline import IKBaseline, attachments_on_upright_rig
+from synthesis.ik_baseline import IKBaseline, attachments_on_upright_rig, stands_upright
 from synthesis.methods import METHODS, Method
 from synthesis.scoring import GROUPS, score_run
 
@@ -54,18 +54,24 @@ PAPER = {
 """CoolMoves §4.1.2 numbers, for the report beside ours."""
 
 
+def ik_rig_for(
+    rig: Skeleton, truth: Motion, setup: VRSetup
+) -> tuple[Skeleton, list[Attachment] | None]:
+    """The rig the IK baseline drives for a method whose output is on ``rig``, and its
+    calibration: ``rig`` itself with the nominal attachments when its rest pose stands, else
+    (Bandai's) the avatar rig, calibrated with the attachments ``setup`` used on ``truth``,
+    turned into the avatar's upright joint frames (:func:`attachments_on_upright_rig`)."""
+    if stands_upright(rig):
+        return rig, None
+    measured = setup.attachments(truth, np.random.default_rng(0))
+    return load_rig("avatar").skeleton, attachments_on_upright_rig(measured, truth.skeleton)
+
+
 def ik_baseline_for(database: Database, truth: Motion, setup: VRSetup) -> IKBaseline:
-    """The IK baseline on the database's rig (the method's output rig); a rig whose rest pose
-    does not stand (Bandai's) falls back to the avatar rig, calibrated with the true device
-    attachments turned into its upright joint frames (:func:`attachments_on_upright_rig`;
-    positions only are steered: the rigs' hand frames still differ)."""
-    height = standing_height(truth)
-    try:
-        return IKBaseline(database.skeleton, height)
-    except BodyError:
-        measured = setup.attachments(truth, np.random.default_rng(0))
-        calibration = attachments_on_upright_rig(measured, truth.skeleton)
-        return IKBaseline(load_rig("avatar").skeleton, height, calibration, False)
+    """The IK baseline beside a method on ``database`` (:func:`ik_rig_for`); a calibration
+    from another rig steers positions only (the rigs' hand frames differ)."""
+    rig, calibration = ik_rig_for(database.skeleton, truth, setup)
+    return IKBaseline(rig, standing_height(truth), calibration, calibration is None)
 
 
 def evaluate_fold(
