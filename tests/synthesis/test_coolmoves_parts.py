@@ -89,19 +89,17 @@ def test_pearson_filter_by_hand():
     a = np.array([1.0, 2.0, 3.0, 4.0])  # deviations -1.5 -0.5 0.5 1.5
     b = np.array([1.0, 3.0, 2.0, 4.0])  # deviations -1.5 0.5 -0.5 1.5: r = 4 / 5 = 0.8
     assert correlation.pearson(a, b) == pytest.approx(0.8)
+    # Hands and feet as one (X, Y, Z) series each (§3.1.2): x moving as a and b, y still,
+    # z at their heights; r of the 12-value series, the same for all four pairs.
     hands, feet = np.zeros((2, 4, 2, 3))
-    hands[:, :, 0] = a[:, None]
-    feet[:, :, 0] = b[:, None]
-    # x of both hands with x of both feet: 4 of the 12 hand-foot-axis pairs at r = 0.8.
-    assert correlation.hand_foot_correlation(hands, feet) == pytest.approx(0.8 * 4 / 12)
+    hands[..., 0], feet[..., 0] = a[:, None], b[:, None]
+    hands[..., 2], feet[..., 2] = -0.3, -1.5
+    expected = np.corrcoef(hands[:, 0].T.ravel(), feet[:, 0].T.ravel())[0, 1]
+    assert correlation.hand_foot_correlation(hands, feet) == pytest.approx(expected)
     assert correlation.keeps(hands, feet)
-    # Only left hand x with left foot x: 1 of 12 -> 0.0667 < 0.1, dropped.
-    hands[:, 1, 0] = 0.0
-    feet[:, 1, 0] = 0.0
-    assert correlation.hand_foot_correlation(hands, feet) == pytest.approx(0.8 / 12)
-    assert not correlation.keeps(hands, feet)
-    # Anti-phase coupling counts as much as in-phase coupling.
-    assert correlation.hand_foot_correlation(hands, -feet) == pytest.approx(0.8 / 12)
+    # Signed: feet moving against the hands, below them, do not pass.
+    assert correlation.hand_foot_correlation(hands, feet * [-1, 1, -1]) < -0.5
+    assert not correlation.keeps(hands, feet * [-1, 1, -1])
 
 
 def test_pearson_of_quadrature_signals_is_zero():
