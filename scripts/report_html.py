@@ -19,7 +19,8 @@ PICTURES = (
 MIME = {".png": "image/png", ".gif": "image/gif"}
 
 
-def _image(path: Path, caption: str) -> str:
+def image_html(path: Path, caption: str) -> str:
+    """A figure with the picture at ``path`` inlined (PNG or GIF) and its caption."""
     data = base64.b64encode(path.read_bytes()).decode("ascii")
     return (
         f'<figure><img alt="{html.escape(caption)}" '
@@ -28,7 +29,8 @@ def _image(path: Path, caption: str) -> str:
     )
 
 
-def _table(rows: list[list[str]], header: list[str]) -> str:
+def table_html(rows: list[list[str]], header: list[str]) -> str:
+    """An HTML table: ``rows`` of HTML cells under a plain-text ``header``."""
     head = "".join(f"<th>{html.escape(h)}</th>" for h in header)
     body = "".join("<tr>" + "".join(f"<td>{cell}</td>" for cell in row) + "</tr>" for row in rows)
     return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
@@ -48,15 +50,25 @@ def render_report(results: dict[str, Any], out_dir: Path) -> str:
     ]
     metrics = [[html.escape(k), f"{v:.4g}"] for k, v in results["metrics"].items()]
     figures = [
-        _image(out_dir / results["outputs"][key], caption)
+        image_html(out_dir / results["outputs"][key], caption)
         for key, caption in PICTURES
         if key in results["outputs"] and (out_dir / results["outputs"][key]).is_file()
     ]
     about = {
         k: results.get(k) for k in ("motion", "body", "devices", "synthesis", "seeds", "versions")
     }
+    body = f"""<h1>Scenario <code>{html.escape(results["scenario"])}</code>: {verdict}</h1>
+<h2>Checks</h2>{table_html(checks, ["check", "value", "threshold", "passed"])}
+{"".join(figures)}
+<h2>All metrics</h2>{table_html(metrics, ["metric", "value"])}
+<h2>Run</h2><pre>{html.escape(json.dumps(about, indent=2, default=str))}</pre>"""
+    return page(f"avatarsim: {results['scenario']}", body)
+
+
+def page(title: str, body: str) -> str:
+    """A self-contained HTML page: ``title`` (plain text) and ``body`` (HTML), one style."""
     return f"""<!doctype html>
-<html><head><meta charset="utf-8"><title>avatarsim: {html.escape(results["scenario"])}</title>
+<html><head><meta charset="utf-8"><title>{html.escape(title)}</title>
 <style>
 body {{ font-family: system-ui, sans-serif; margin: 2em; color: #222; }}
 table {{ border-collapse: collapse; margin: 1em 0; }}
@@ -65,10 +77,6 @@ td, th {{ border: 1px solid #ccc; padding: 0.3em 0.7em; text-align: left; }}
 figure {{ margin: 1.5em 0; }} img {{ max-width: 100%; }}
 pre {{ background: #f5f5f5; padding: 1em; overflow-x: auto; }}
 </style></head><body>
-<h1>Scenario <code>{html.escape(results["scenario"])}</code>: {verdict}</h1>
-<h2>Checks</h2>{_table(checks, ["check", "value", "threshold", "passed"])}
-{"".join(figures)}
-<h2>All metrics</h2>{_table(metrics, ["metric", "value"])}
-<h2>Run</h2><pre>{html.escape(json.dumps(about, indent=2, default=str))}</pre>
+{body}
 </body></html>
 """

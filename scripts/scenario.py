@@ -114,7 +114,6 @@ class SynthesisSpec:
     database_subjects: int = 4
     database_duration_s: float = 8.0
     foot_contact: bool = True  # CoolMoves' stance-foot clean-up (beyond the paper)
-    arm_ik: float = 1.0  # CoolMoves' arm correction toward the controllers (0 = the paper's)
 
 
 @dataclass(frozen=True)
@@ -260,8 +259,6 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
         raise ScenarioError(
             f"synthesis.database_duration_s must be above 0, at most {MAX_MOTION_S:g}"
         )
-    if synthesis and not 0 <= synthesis.arm_ik <= 1:
-        raise ScenarioError(f"synthesis.arm_ik must be 0-1, got {synthesis.arm_ik}")
     if motion.corrupt is not None and motion.corrupt not in CORRUPTIONS:
         raise ScenarioError(f"motion.corrupt must be one of {CORRUPTIONS}, got {motion.corrupt!r}")
     if not 0 < motion.duration_s <= MAX_MOTION_S:

@@ -36,10 +36,11 @@ import mujoco
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from avatar_models import Motion, Skeleton, quat
+from avatar_models import Motion, Skeleton, body17, quat
 from avatar_models.body import build_body
 from avatar_models.body.ik import HumanoidIK, IKSettings, humanoid_model, motion_from_qpos
 from avatar_models.measure import standing_height
+from avatar_models.rigs import identify_rig
 from render_cams import TrackingStream
 from render_cams.vr import HEADSET_AND_CONTROLLERS, Attachment, nominal_attachment
 from synthesis.base import DEFAULT_RATE_HZ, FrameBatch, Poses, SynthesisError, Synthesizer
@@ -115,6 +116,51 @@ def _clip_norm(v: np.ndarray, limit: np.ndarray) -> np.ndarray:
 def cadence(speed: float) -> float:
     """Steps per second at horizontal ``speed`` m/s (:data:`CADENCE_STEPS_PER_S`)."""
     return CADENCE_STEPS_PER_S[0] + CADENCE_STEPS_PER_S[1] * speed
+
+
+def rest_body_frame(skeleton: Skeleton) -> np.ndarray:
+    """``(3, 3)`` rotation whose columns are the forward, left and up axes of ``skeleton``'s
+    rest pose (up: pelvis to neck; left: right to left shoulder, made orthogonal to up).
+
+    Near the identity for a rig whose rest pose stands facing +X (the avatar rig, CMU, the
+    generator's); a rig stored lying or turned (Bandai's rest pose lies along +Y, as its
+    BVH's Y-up frame) gives the turn that stands it up.
+    """
+    rest = skeleton.rest_positions()[identify_rig(skeleton).body17_indices(skeleton)]
+    at = {name: rest[i] for i, name in enumerate(body17.BODY17)}
+    up = at["neck"] - at["pelvis"]
+    up /= np.linalg.norm(up)
+    left = at["l_shoulder"] - at["r_shoulder"]
+    left -= (left @ up) * up
+    left /= np.linalg.norm(left)
+    return np.stack([np.cross(left, up), left, up], axis=1)
+
+
+def stands_upright(skeleton: Skeleton) -> bool:
+    """Whether ``skeleton``'s rest pose stands (its trunk within 25 deg of +Z, facing within
+    25 deg of +X): its joint frames are then those the IK's heading and lean assume."""
+    frame = rest_body_frame(skeleton)
+    return bool(frame[2, 2] > np.cos(np.radians(25.0)) and frame[0, 0] > np.cos(np.radians(25.0)))
+
+
+def attachments_on_upright_rig(
+    attachments: Sequence[Attachment], source: Skeleton
+) -> list[Attachment]:
+    """Device attachments measured in the joint frames of ``source`` re-expressed in the
+    frames of a rig whose rest pose stands facing +X (the IK's), for the same body.
+
+    A joint frame of ``source`` is its upright counterpart turned by ``F`` (the rest frames
+    of one body differ by the turn that stands the rest pose up, :func:`rest_body_frame`):
+    ``R_device = R_source R_att = R_upright F^T R_att``, so the attachment there is
+    ``F^T R_att`` with offset ``F^T p_att``. Without this a Bandai headset's "forward" is
+    the head's sideways axis and its "up" points ahead: the IK read every standing frame as
+    a face-down body and laid it down (126 cm lower-body error on Bandai dataset-2).
+    """
+    turn = rest_body_frame(source).T
+    q_turn = quat.from_matrix(turn)
+    return [
+        Attachment(a.joint, turn @ a.position, quat.mul(q_turn, a.rotation)) for a in attachments
+    ]
 
 
 @dataclass

@@ -3,10 +3,10 @@
 Database: the generator's five Table-1 activities for four subjects (two in ``quick`` mode),
 8 s each, all in one database; input: a held-out subject's boxing seen by the default
 ``VRSetup``. Latency is the wall time of each ``step()`` call on one thread, with the
-default options (arm IK on) and in the paper-faithful mode ``Options(arm_ik=0)`` (the KD-tree
-query runs with ``workers=1``). Baselines are the paper's (CoolMoves §3.1.5, a Core i7-7700HQ):
-the Python backend ran at 152 Hz (6.6 ms a frame) and the mixture-model variant at 44 Hz
-(22.7 ms); a VR frame at 90 Hz leaves 11.1 ms.
+registered ``coolmoves`` (the paper's pipeline) and ``coolmoves+arm-ik`` (arm IK on top,
+:mod:`synthesis.methods`); the KD-tree query runs with ``workers=1``. Baselines are the
+paper's (CoolMoves §3.1.5, a Core i7-7700HQ): the Python backend ran at 152 Hz (6.6 ms a
+frame) and the mixture-model variant at 44 Hz (22.7 ms); a VR frame at 90 Hz leaves 11.1 ms.
 """
 
 from __future__ import annotations
@@ -18,8 +18,9 @@ import numpy as np
 from avatar_models.generator import generate, sample_subject
 from render_cams import VRSetup
 from scripts.benchmarks import BenchRow, best_of
-from synthesis.coolmoves import CoolMoves, Options, build_database
+from synthesis.coolmoves import build_database
 from synthesis.evaluate import PAPER_ACTIVITIES
+from synthesis.methods import MethodInputs, build
 from synthesis.scoring import step_latencies_ms
 
 PAPER_BACKEND_MS = 1000.0 / 152.0
@@ -41,12 +42,12 @@ def run(quick: bool = False) -> list[BenchRow]:
     build_s = time.perf_counter() - t0
     held_out = subjects[-1]
     stream = VRSetup().sample(generate("box", held_out, 4.0 if quick else 8.0, 90.0, seed=99))
-    synth = CoolMoves(database, held_out.height_m)
+    inputs = MethodInputs(lambda: database, held_out.height_m, database.skeleton)
+    synth = build("coolmoves", inputs)
     lat = step_latencies_ms(synth, stream)
     batch_s = best_of(lambda: synth.run(stream), repeat=2 if quick else 3)
-    paper = CoolMoves(database, held_out.height_m, Options(arm_ik=0.0))
-    paper_lat = step_latencies_ms(paper, stream)
-    gmm = CoolMoves(database, held_out.height_m, Options(matcher="gmm"))
+    arm_ik_lat = step_latencies_ms(build("coolmoves+arm-ik", inputs), stream)
+    gmm = build("coolmoves-gmm", inputs)
     gmm_lat = step_latencies_ms(gmm, stream[: 180 if quick else 360])
     note = f"{database.n_windows} windows, {stream.n_samples} frames"
     return [
@@ -67,17 +68,17 @@ def run(quick: bool = False) -> list[BenchRow]:
             note,
         ),
         BenchRow(
-            "coolmoves step p50 (paper, no arm IK)",
+            "coolmoves+arm-ik step p50",
             "ms",
-            float(np.percentile(paper_lat, 50)),
+            float(np.percentile(arm_ik_lat, 50)),
             PAPER_BACKEND_MS,
             "paper Python backend (152 Hz)",
             note,
         ),
         BenchRow(
-            "coolmoves step p99 (paper, no arm IK)",
+            "coolmoves+arm-ik step p99",
             "ms",
-            float(np.percentile(paper_lat, 99)),
+            float(np.percentile(arm_ik_lat, 99)),
             FRAME_BUDGET_MS,
             "90 Hz frame budget",
             note,

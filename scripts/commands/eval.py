@@ -1,7 +1,9 @@
 """``avatarsim eval METHOD --library DIR|builtin --protocol cross-subject|cross-trial``.
 
 CoolMoves' accuracy protocols (§4.1) with the IK baseline beside: prints the per-class and
-overall tables, writes the contract JSON and Fig. 4-like bar plots into ``--out``. Exit 2 for
+overall tables, writes the contract JSON and Fig. 4-like bar plots into ``--out``.
+``eval leaderboard`` runs every registered method instead (:mod:`scripts.leaderboard`) and
+writes ``leaderboard.json``, ``.png`` and ``.html``. Exit 2 for
 bad input (unknown method or protocol, a folder without clips, cross-subject on clips
 without subject labels).
 """
@@ -50,11 +52,49 @@ def _table(results: dict) -> Table:
     return table
 
 
+def _board_table(board: dict) -> Table:
+    from scripts.leaderboard import COLUMNS
+
+    table = Table(title=f"leaderboard {board['protocol']}, {board['trials']} test trials (cm)")
+    table.add_column("method")
+    for header in COLUMNS.values():
+        table.add_column(header, justify="right")
+    for name, s in board["methods"].items():
+        table.add_row(escape(name), *(f"{s[k]:.3g}" for k in COLUMNS))
+    return table
+
+
+def write_leaderboard(board: dict, out: Path, json_out: Path | None) -> None:
+    """Print the leaderboard; write its JSON, plot and page into ``out``."""
+    from scripts.leaderboard import render_page, write_plot
+
+    console.print(_board_table(board))
+    for fail in board["failed_folds"]:
+        console.print(
+            "[yellow]fold failed[/] "
+            + escape(f"{fail['class']}/{fail['held_out']}: {fail['reason']}")
+        )
+    out.mkdir(parents=True, exist_ok=True)
+    plot = write_plot(board, out / "leaderboard.png")
+    (out / "leaderboard.html").write_text(render_page(board, plot))
+    board["plot"], board["page"] = str(plot), str(out / "leaderboard.html")
+    emit_json(out / "leaderboard.json", board)
+    emit_json(json_out, board)
+    console.print(f"wrote {out}/leaderboard.json, leaderboard.png and leaderboard.html")
+
+
 def register(app: typer.Typer) -> None:
     @app.command(name="eval")
     @user_errors
     def eval_(
-        method: Annotated[str, typer.Argument(help="coolmoves or coolmoves-gmm.")],
+        method: Annotated[
+            str,
+            typer.Argument(
+                help="coolmoves (the paper's), coolmoves+arm-ik, coolmoves-gmm, "
+                "coolmoves-centroid-align (synthesis.methods), or leaderboard: every "
+                "registered method on the same test motions, accuracy, physics and latency."
+            ),
+        ],
         library: Annotated[
             str, typer.Option(help="'builtin' (generator) or a mocap folder (Bandai, CMU).")
         ] = "builtin",
@@ -85,9 +125,11 @@ def register(app: typer.Typer) -> None:
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
     ) -> None:
-        """Accuracy protocols of a synthesis method, IK baseline beside (CoolMoves §4.1)."""
+        """Accuracy protocols of a synthesis method, IK baseline beside (CoolMoves §4.1), or
+        ``leaderboard``: every registered method (scripts/leaderboard.py)."""
+        from scripts.leaderboard import run_leaderboard
         from synthesis.evaluate import (
-            METHODS,
+            EVALUABLE,
             PROTOCOLS,
             EvaluationError,
             builtin_trials,
@@ -107,8 +149,10 @@ def register(app: typer.Typer) -> None:
             if not lo <= value <= hi:  # also NaN
                 raise EvaluationError(f"{option} must be {lo:g}-{hi:g}, got {value}")
         check_outputs(json_out=json_out, out=out)
-        if method not in METHODS:
-            raise EvaluationError(f"unknown method {method!r}; available: {', '.join(METHODS)}")
+        if method not in (*EVALUABLE, "leaderboard"):
+            raise EvaluationError(
+                f"unknown method {method!r}; available: {', '.join(EVALUABLE)}, leaderboard"
+            )
         if protocol not in PROTOCOLS:
             raise EvaluationError(f"unknown protocol {protocol!r}; use {' or '.join(PROTOCOLS)}")
         wanted = None if classes is None else [c.strip() for c in classes.split(",") if c.strip()]
@@ -132,6 +176,11 @@ def register(app: typer.Typer) -> None:
             def progress(done: int, total: int, label: str) -> None:
                 bar.update(task, completed=done, total=total, description=escape(label))
 
+            if method == "leaderboard":
+                board = run_leaderboard(trials, protocol, progress=progress)
+                board.update(library=library, seed=seed, quick=quick, class_by=class_by)
+                write_leaderboard(board, out, json_out)
+                return
             results = run_protocol(
                 trials,
                 protocol,

@@ -8,16 +8,17 @@ import numpy as np
 from avatar_models.generator import generate_library
 from avatar_models.measure import standing_height
 from avatar_models.motion import Motion
+from render_cams.vr import HEADSET_AND_CONTROLLERS, Attachment
 from scripts.method_score import score_method
 from scripts.run_context import RunContext
 from scripts.scenario import Scenario, ScenarioError
 from scripts.stages.physics import config as physics_config
 from sim.humanoid import Humanoid
 from synthesis.base import Synthesizer
-from synthesis.coolmoves import CoolMoves, Options, build_database
+from synthesis.coolmoves import build_database
+from synthesis.ik_baseline import attachments_on_upright_rig
+from synthesis.methods import METHODS, MethodInputs, build
 from synthesis.scoring import GROUPS
-
-METHODS = ("coolmoves", "ik")
 
 METRICS = {
     **{
@@ -56,18 +57,35 @@ def database_takes(ctx: RunContext) -> list[Motion]:
     )
 
 
-def make_synthesizer(method: str, ctx: RunContext, user_height_m: float) -> Synthesizer:
-    if method == "coolmoves":
-        spec = ctx.scenario.synthesis
-        options = Options(foot_contact=spec.foot_contact, arm_ik=spec.arm_ik)
-        return CoolMoves(build_database(database_takes(ctx)), user_height_m, options)
-    if method == "ik":
-        from synthesis.ik_baseline import IKBaseline
+def ik_calibration(ctx: RunContext) -> list[Attachment] | None:
+    """The VR devices' attachments on the humanoid's rig: None (the nominal ones) for the
+    truth's own rig; on a rig retargeted from a foreign one, the attachments the stream was
+    sampled with, turned into the upright rig's joint frames."""
+    if not ctx.humanoid.retargeted:
+        return None
+    offsets = ctx.vr_stream.meta["offsets"]
+    measured = [Attachment(**offsets[device]) for device in HEADSET_AND_CONTROLLERS]
+    return attachments_on_upright_rig(measured, ctx.motion.skeleton)
 
-        # The IK baseline drives the humanoid's rig (the ground truth's own, or the avatar rig
-        # a foreign rig was retargeted onto), so errors compare like for like.
-        return IKBaseline(ctx.humanoid.body.skeleton, user_height_m=user_height_m)
-    raise ScenarioError(f"unknown synthesis method {method!r}; known: {', '.join(METHODS)}")
+
+def method_inputs(ctx: RunContext, user_height_m: float) -> MethodInputs:
+    """The registry's inputs for this scenario: a database of :func:`database_takes` (built
+    once, for every CoolMoves variant), and the humanoid's rig (the ground truth's own, or the
+    avatar rig a foreign rig was retargeted onto) for the IK baseline, so that errors
+    compare like for like."""
+    return MethodInputs(
+        database_factory=lambda: build_database(database_takes(ctx)),
+        user_height_m=user_height_m,
+        rig=ctx.humanoid.body.skeleton,
+        calibration=ik_calibration(ctx),
+        coolmoves={"foot_contact": ctx.scenario.synthesis.foot_contact},
+    )
+
+
+def make_synthesizer(method: str, inputs: MethodInputs) -> Synthesizer:
+    if method not in METHODS:
+        raise ScenarioError(f"unknown synthesis method {method!r}; known: {', '.join(METHODS)}")
+    return build(method, inputs)
 
 
 def run(ctx: RunContext) -> None:
@@ -81,8 +99,9 @@ def run(ctx: RunContext) -> None:
     )
     checks = physics_config(ctx)  # the scenario's [physics] settings, as for the ground truth
     outputs: dict[str, Humanoid] = {}
+    inputs = method_inputs(ctx, user_height_m)
     for method in spec.methods:
-        synth = make_synthesizer(method, ctx, user_height_m)
+        synth = make_synthesizer(method, inputs)
         result = score_method(synth, ctx.motion, stream, checks)
         outputs[method] = result.humanoid
         score = result.score

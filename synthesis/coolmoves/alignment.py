@@ -9,9 +9,13 @@ paper's variant of Kovar & Gleicher's closed form (Y up in the paper, ``x, z`` h
     theta = arctan(num / den)
 
 ``q`` the input window, ``s`` the database window, sums over the ``n`` samples of both
-hands, and ``c_i`` the contribution of each sample, "from 0 to 1, increasing in step-size
-1/n from the start of the feature vector (0 ms) to the end (100 ms)": ``c_i = (i + 1) / n``,
-so the newest sample counts fully.
+hands, and ``c_i`` the contribution of each sample: "We assign the c_i from 0 to 1,
+increasing them in step-size 1/n from the start of the feature vector (0 ms) to the end
+(100 ms)": ``c_i = i / n``, ``i = 0 .. n-1``, so the oldest sample counts 0. With ``n``
+samples the printed range and step cannot both hold (the last is ``(n - 1) / n``); the other
+reading, ``i / (n - 1)``, differs by a constant factor, which both the numerator and the
+denominator carry (the centroid terms too: ``c c / sum c`` scales like ``c``), so the angle is
+the same either way.
 
 Pivot. The ``1 / sum c`` terms come from Kovar & Gleicher, who solve for a rotation *and* a
 horizontal translation: they make the angle that of the clouds about their weighted centroids
@@ -38,8 +42,9 @@ import numpy as np
 
 
 def ramp_weights(n: int) -> np.ndarray:
-    """``(n,)`` contributions ``c_i = (i + 1) / n``, oldest sample first (§3.1.4)."""
-    return np.arange(1, n + 1) / n
+    """``(n,)`` contributions ``c_i = i / n``, from 0 in steps of ``1 / n``, oldest sample
+    first (§3.1.4)."""
+    return np.arange(n) / n
 
 
 def alignment_yaw(

@@ -174,7 +174,7 @@ def _trial_windows(
     return np.concatenate(windows), np.concatenate(ends)
 
 
-def _hands_and_feet(motion: Motion) -> tuple[np.ndarray, np.ndarray]:
+def hands_and_feet(motion: Motion) -> tuple[np.ndarray, np.ndarray]:
     """Head-relative wrists and ankles ``(T, 2, 3)`` each, for the correlation filter."""
     rig = identify_rig(motion.skeleton)
     pos = motion.global_positions()
@@ -212,7 +212,7 @@ def build_database(
                 f"first ({reference!r}); a database holds one rig"
             )
         motion = motion_at_rate(motion, RATE_HZ)
-        score = correlation.hand_foot_correlation(*_hands_and_feet(motion))
+        score = correlation.hand_foot_correlation(*hands_and_feet(motion))
         kept = score >= correlation_threshold and motion.n_frames >= window
         clips.append({**labels(motion), "correlation": score, "kept": bool(kept)})
         if not kept:

@@ -58,7 +58,8 @@ proportions in Winter, *Biomechanics and Motor Control of Human Movement*, Fig. 
 
 @dataclass(frozen=True)
 class Options:
-    """Switches of the method (the paper's ablation turns off alignment and smoothing).
+    """Switches of the method; the defaults are the paper's pipeline (its ablation turns off
+    alignment and smoothing).
 
     Attributes:
         k: matches per hand. max_distance: KD-tree neighbourhood threshold.
@@ -70,7 +71,9 @@ class Options:
         arm_ik: beyond the paper, the share (0..1) by which each arm is bent with two-bone IK
             (:mod:`.two_bone`) so that its controller point reaches the tracked controller;
             applied where that hand is tracked, after the joint limits, which are applied
-            again. 0 is the paper's output (hands from the blended database poses only).
+            again. 0 (the default) is the paper's output: hands from the blended database
+            poses only; the registered method ``coolmoves+arm-ik`` sets 1
+            (:mod:`synthesis.methods`).
         foot_contact: beyond the paper, pin stance feet to the floor (:mod:`.foot_contact`).
     """
 
@@ -81,7 +84,7 @@ class Options:
     smooth: bool = True
     clamp: bool = True
     matcher: str = "knn"
-    arm_ik: float = 1.0
+    arm_ik: float = 0.0
     foot_contact: bool = False
 
 

@@ -10,10 +10,11 @@ database) and :mod:`.protocol` (running and aggregating them). Scoring a run is
 from synthesis.evaluate.folds import PROTOCOLS, Fold, database_for, folds
 from synthesis.evaluate.protocol import (
     ABLATION,
-    METHODS,
+    EVALUABLE,
     PAPER,
     evaluate_fold,
     ik_baseline_for,
+    ik_rig_for,
     run_protocol,
     summarise,
 )
@@ -29,7 +30,7 @@ from synthesis.evaluate.trials import (
 
 __all__ = [
     "ABLATION",
-    "METHODS",
+    "EVALUABLE",
     "PAPER",
     "PAPER_ACTIVITIES",
     "PROTOCOLS",
@@ -42,6 +43,7 @@ __all__ = [
     "evaluate_fold",
     "folds",
     "ik_baseline_for",
+    "ik_rig_for",
     "library_trials",
     "run_protocol",
     "summarise",

@@ -22,15 +22,18 @@ PROTOCOLS = ("cross-subject", "cross-trial")
 
 @dataclass(frozen=True, eq=False)
 class Fold:
-    """One leave-one-group-out fold of one class: the held-out group, train and test trials."""
+    """One leave-one-group-out fold of one class: the held-out group, train and test trials,
+    and the protocol whose groups they are."""
 
     cls: str
     held_out: str
     train: list[Trial]
     test: list[Trial]
+    protocol: str = "cross-trial"
 
 
-def _group(trial: Trial, protocol: str) -> str | None:
+def group_of(trial: Trial, protocol: str) -> str | None:
+    """The group ``trial`` is held out with under ``protocol`` (its subject, or its trial)."""
     if protocol == "cross-subject":
         return trial.subject
     return f"{trial.subject}/{trial.take}" if trial.take is not None else trial.name
@@ -52,15 +55,15 @@ def folds(trials: Sequence[Trial], protocol: str) -> tuple[list[Fold], dict[str,
     out, skipped = [], {}
     for cls in sorted({t.cls for t in trials}):
         members = [t for t in trials if t.cls == cls]
-        groups = sorted({g for t in members if (g := _group(t, protocol)) is not None})
+        groups = sorted({g for t in members if (g := group_of(t, protocol)) is not None})
         if len(groups) < 2:
             label = "subjects" if protocol == "cross-subject" else "trials"
             skipped[cls] = f"{len(groups)} {label}; {protocol} needs at least 2"
             continue
         for held in groups:
-            test = [t for t in members if _group(t, protocol) == held]
-            train = [t for t in members if _group(t, protocol) != held]
-            out.append(Fold(cls, held, train, test))
+            test = [t for t in members if group_of(t, protocol) == held]
+            train = [t for t in members if group_of(t, protocol) != held]
+            out.append(Fold(cls, held, train, test, protocol))
     return out, skipped
 
 

@@ -18,26 +18,23 @@ from dataclasses import replace
 
 import numpy as np
 
-from avatar_models import Motion
-from avatar_models.body import BodyError
+from avatar_models import Motion, Skeleton
 from avatar_models.measure import standing_height
 from avatar_models.rigs import load_rig
 from render_cams import VRSetup
+from render_cams.vr import Attachment
 from synthesis.base import SynthesisError
-from synthesis.coolmoves import CoolMoves, Database, Options
+from synthesis.coolmoves import CoolMoves, Database
 from synthesis.evaluate.folds import Fold, database_for, folds
 from synthesis.evaluate.trials import EvaluationError, Trial, turned
-from synthesis.ik_baseline import IKBaseline
+from synthesis.evaluate.validation import choose_max_distance
+from synthesis.ik_baseline import IKBaseline, attachments_on_upright_rig, stands_upright
+from synthesis.methods import METHODS, Method
 from synthesis.scoring import GROUPS, score_run
 
-METHODS: dict[str, Options] = {
-    "coolmoves": Options(),
-    "coolmoves-gmm": Options(matcher="gmm"),
-    "coolmoves-centroid-align": Options(align_about_centroid=True),
-}
-"""Evaluable methods and their options (the GMM variant is the paper's slower alternative;
-``coolmoves-centroid-align`` aligns with the paper's printed equation, see
-:mod:`synthesis.coolmoves.alignment`)."""
+EVALUABLE = tuple(name for name, m in METHODS.items() if m.options is not None)
+"""The registered methods this protocol evaluates (the CoolMoves variants, the IK baseline
+beside each; every registered method side by side is the leaderboard)."""
 ABLATION: dict[str, dict[str, bool]] = {
     "no_alignment_no_smoothing": {"align": False, "smooth": False},
     "alignment_no_smoothing": {"align": True, "smooth": False},
@@ -57,32 +54,48 @@ PAPER = {
 """CoolMoves §4.1.2 numbers, for the report beside ours."""
 
 
+def ik_rig_for(
+    rig: Skeleton, truth: Motion, setup: VRSetup
+) -> tuple[Skeleton, list[Attachment] | None]:
+    """The rig the IK baseline drives for a method whose output is on ``rig``, and its
+    calibration: ``rig`` itself with the nominal attachments when its rest pose stands, else
+    (Bandai's) the avatar rig, calibrated with the attachments ``setup`` used on ``truth``,
+    turned into the avatar's upright joint frames (:func:`attachments_on_upright_rig`)."""
+    if stands_upright(rig):
+        return rig, None
+    measured = setup.attachments(truth, np.random.default_rng(0))
+    return load_rig("avatar").skeleton, attachments_on_upright_rig(measured, truth.skeleton)
+
+
 def ik_baseline_for(database: Database, truth: Motion, setup: VRSetup) -> IKBaseline:
-    """The IK baseline on the database's rig (the method's output rig); a rig whose rest pose
-    does not stand (Bandai's) falls back to the avatar rig, calibrated with the true device
-    offsets (positions only, its joint frames differ)."""
-    height = standing_height(truth)
-    try:
-        return IKBaseline(database.skeleton, height)
-    except BodyError:
-        calibration = setup.attachments(truth, np.random.default_rng(0))
-        return IKBaseline(load_rig("avatar").skeleton, height, calibration, False)
+    """The IK baseline beside a method on ``database`` (:func:`ik_rig_for`); a calibration
+    from another rig steers positions only (the rigs' hand frames differ)."""
+    rig, calibration = ik_rig_for(database.skeleton, truth, setup)
+    return IKBaseline(rig, standing_height(truth), calibration, calibration is None)
 
 
 def evaluate_fold(
     fold: Fold,
-    options: Options,
+    method: Method,
     setup: VRSetup,
     ablation: bool = True,
     baseline_cache: dict | None = None,
     heading_deg: float = 0.0,
     db_headings: int = 1,
+    tune: bool = True,
 ) -> list[dict]:
-    """Per test trial of ``fold``: the method, its ablation variants and the IK baseline.
+    """Per test trial of ``fold``: the CoolMoves variant ``method``, its ablation variants
+    (switched from the variant's options) and the IK baseline.
 
     ``heading_deg``: turn each test motion by a random yaw up to this (:func:`turned`);
-    ``db_headings``: turned copies of the database (:func:`database_for`).
+    ``db_headings``: turned copies of the database (:func:`database_for`); ``tune``: the
+    distance threshold chosen on the fold's training data
+    (:func:`~synthesis.evaluate.validation.choose_max_distance`; each row records it).
     """
+    options = method.options
+    if tune:
+        chosen = choose_max_distance(fold.train, fold.protocol, options, setup)
+        options = replace(options, max_distance=chosen)
     database = database_for(fold.train, db_headings)
     cache = {} if baseline_cache is None else baseline_cache
     rows = []
@@ -91,6 +104,7 @@ def evaluate_fold(
         stream = setup.sample(truth, seed=trial.seed)
         height = standing_height(truth)
         row = {"trial": trial.name, "cls": trial.cls, "held_out": fold.held_out}
+        row["max_distance"] = options.max_distance
         row["method"] = score_run(CoolMoves(database, height, options), truth, stream).row()
         if ablation:
             row["ablation"] = {
@@ -133,6 +147,8 @@ def summarise(rows: Sequence[dict]) -> dict:
         "baseline_frames_per_s": rate("baseline"),
         "trials": len(rows),
     }
+    if all("max_distance" in r for r in rows):
+        out["max_distance_mean"] = mean(lambda r: r["max_distance"])
     if all("ablation" in r for r in rows):
         out["ablation_full_cm"] = {k: mean(lambda r, k=k: r["ablation"][k]) for k in ABLATION}
     return out
@@ -162,6 +178,7 @@ def run_protocol(
     progress: Callable[[int, int, str], None] | None = None,
     heading_deg: float = 0.0,
     db_headings: int = 1,
+    tune: bool = True,
 ) -> dict:
     """Evaluate ``method`` on ``trials`` under ``protocol``.
 
@@ -171,10 +188,11 @@ def run_protocol(
     ``frames_per_s`` and ``baseline_frames_per_s``, ``ablation_full_cm``, ``trials``.
     ``progress(done, total, label)`` is called after every fold. ``heading_deg`` turns each
     test motion by a random yaw up to this (the database keeps its headings);
-    ``db_headings > 1`` adds turned copies to each fold's database (:func:`database_for`).
+    ``db_headings > 1`` adds turned copies to each fold's database (:func:`database_for`);
+    ``tune`` chooses the distance threshold per fold on its training data.
     """
-    if method not in METHODS:
-        raise EvaluationError(f"unknown method {method!r}; available: {', '.join(METHODS)}")
+    if method not in EVALUABLE:
+        raise EvaluationError(f"unknown method {method!r}; available: {', '.join(EVALUABLE)}")
     if not trials:
         raise EvaluationError("no trials to evaluate")
     all_folds, skipped = folds(trials, protocol)
@@ -186,7 +204,7 @@ def run_protocol(
         try:
             rows.extend(
                 evaluate_fold(
-                    fold, METHODS[method], setup, ablation, cache, heading_deg, db_headings
+                    fold, METHODS[method], setup, ablation, cache, heading_deg, db_headings, tune
                 )
             )
         except SynthesisError as exc:  # e.g. every training clip fails the correlation filter

@@ -13,22 +13,45 @@ from synthesis.coolmoves import correlation
 from synthesis.coolmoves.alignment import alignment_yaw, ramp_weights
 from synthesis.coolmoves.blend import blend_rotations, group_weights, inverse_distance_weights
 from synthesis.coolmoves.features import (
+    RATE_HZ,
+    WINDOW_SAMPLES,
     feature_vectors,
     search_vectors,
     speed_windows,
     window_stride,
 )
-from synthesis.coolmoves.knn import KNNMatcher
+from synthesis.coolmoves.knn import K_NEIGHBOURS, KNNMatcher
 from synthesis.coolmoves.limits import JointLimits
 from synthesis.coolmoves.smoothing import ewma, ewma_step
 from tests.synthesis.conftest import yaw_matrix
 
 
 def test_window_geometry_is_the_papers():
-    # 100 ms at 90 Hz = 9 samples, 50 ms overlap -> 5 shared samples, a new window every 4.
-    assert window_stride(9, 90.0) == 4
-    np.testing.assert_allclose(ramp_weights(9), np.arange(1, 10) / 9)
-    assert ramp_weights(9)[-1] == 1.0
+    """§3.1.2: 90 Hz, 100 ms windows of 9 samples overlapping their neighbours by 50 ms
+    (half a window); §3.1.3: the top 5 matches per hand."""
+    assert RATE_HZ == 90.0 and WINDOW_SAMPLES == 9 and K_NEIGHBOURS == 5
+    shared = WINDOW_SAMPLES - window_stride(WINDOW_SAMPLES, RATE_HZ)
+    # 50 ms at 90 Hz is 4.5 sample periods: the windows share 4 or 5 samples.
+    assert abs(shared - 0.5 * WINDOW_SAMPLES) <= 0.5
+
+
+def test_alignment_contributions_step_from_zero():
+    """§3.1.4: "c_i from 0 to 1, increasing them in step-size 1/n" from the oldest sample."""
+    c = ramp_weights(9)
+    assert c[0] == 0.0
+    np.testing.assert_allclose(np.diff(c), 1 / 9)
+    # The reading that ends at exactly 1 (step 1/(n-1)) is a constant factor away: the
+    # closed form gives the same angle, with and without the centroid terms.
+    rng = np.random.default_rng(4)
+    query, source = rng.normal(size=(1, 9, 2, 3)), rng.normal(size=(1, 3, 9, 2, 3))
+    for centroid in (False, True):
+        ours = alignment_yaw(query, source, free_translation=centroid)
+        scaled = alignment_yaw(query, source, np.full((1, 2), 9 / 8), centroid)
+        np.testing.assert_allclose(ours, scaled, atol=1e-12)
+    # The oldest sample does not count: changing it does not turn the match.
+    moved = query.copy()
+    moved[:, 0] += 5.0
+    np.testing.assert_allclose(alignment_yaw(moved, source), alignment_yaw(query, source))
 
 
 def test_search_vectors_preserve_feature_distances():
@@ -66,19 +89,17 @@ def test_pearson_filter_by_hand():
     a = np.array([1.0, 2.0, 3.0, 4.0])  # deviations -1.5 -0.5 0.5 1.5
     b = np.array([1.0, 3.0, 2.0, 4.0])  # deviations -1.5 0.5 -0.5 1.5: r = 4 / 5 = 0.8
     assert correlation.pearson(a, b) == pytest.approx(0.8)
+    # Hands and feet as one (X, Y, Z) series each (§3.1.2): x moving as a and b, y still,
+    # z at their heights; r of the 12-value series, the same for all four pairs.
     hands, feet = np.zeros((2, 4, 2, 3))
-    hands[:, :, 0] = a[:, None]
-    feet[:, :, 0] = b[:, None]
-    # x of both hands with x of both feet: 4 of the 12 hand-foot-axis pairs at r = 0.8.
-    assert correlation.hand_foot_correlation(hands, feet) == pytest.approx(0.8 * 4 / 12)
+    hands[..., 0], feet[..., 0] = a[:, None], b[:, None]
+    hands[..., 2], feet[..., 2] = -0.3, -1.5
+    expected = np.corrcoef(hands[:, 0].T.ravel(), feet[:, 0].T.ravel())[0, 1]
+    assert correlation.hand_foot_correlation(hands, feet) == pytest.approx(expected)
     assert correlation.keeps(hands, feet)
-    # Only left hand x with left foot x: 1 of 12 -> 0.0667 < 0.1, dropped.
-    hands[:, 1, 0] = 0.0
-    feet[:, 1, 0] = 0.0
-    assert correlation.hand_foot_correlation(hands, feet) == pytest.approx(0.8 / 12)
-    assert not correlation.keeps(hands, feet)
-    # Anti-phase coupling counts as much as in-phase coupling.
-    assert correlation.hand_foot_correlation(hands, -feet) == pytest.approx(0.8 / 12)
+    # Signed: feet moving against the hands, below them, do not pass.
+    assert correlation.hand_foot_correlation(hands, feet * [-1, 1, -1]) < -0.5
+    assert not correlation.keeps(hands, feet * [-1, 1, -1])
 
 
 def test_pearson_of_quadrature_signals_is_zero():
@@ -134,14 +155,17 @@ def test_alignment_about_head_keeps_forward_reach():
 
 
 def test_alignment_weights_favour_the_newest_samples():
+    """The samples agree on a turn of 0.5 rad but one: the oldest (c = 0) leaves the angle
+    exactly 0.5, the newest (c = 8/9) pulls it toward its own 0.4 rad less than all."""
     rng = np.random.default_rng(2)
     query = rng.normal(scale=0.3, size=(1, 9, 2, 3))
     source = query @ yaw_matrix(-0.5).T
-    source[:, 0] = query[:, 0] @ yaw_matrix(0.4).T  # the oldest sample disagrees...
-    got = alignment_yaw(query, source[:, None])[0, 0]
-    # ...and counts only 1/9 as much as the newest, so the answer stays near 0.5.
-    flat = alignment_yaw(query, source[:, None], side_weights=np.ones((1, 2)))[0, 0]
-    assert abs(got - 0.5) < 0.1 and got == pytest.approx(flat)
+    oldest, newest = source.copy(), source.copy()
+    oldest[:, 0] = query[:, 0] @ yaw_matrix(-0.4).T
+    newest[:, -1] = query[:, -1] @ yaw_matrix(-0.4).T
+    assert alignment_yaw(query, oldest[:, None])[0, 0] == pytest.approx(0.5, abs=1e-12)
+    pulled = alignment_yaw(query, newest[:, None])[0, 0]
+    assert 0.4 < pulled < 0.5 - 1e-3
 
 
 def test_alignment_ignores_untracked_hand():

@@ -46,7 +46,7 @@ def test_database_rejects_bad_input(train_motions):
 
 def test_streaming_equals_batch(small_db, stream):
     # One core: stepping every sample is bit for bit the batch run, arm IK included.
-    synth = CoolMoves(small_db, TEST_SUBJECT.height_m)
+    synth = CoolMoves(small_db, TEST_SUBJECT.height_m, Options(arm_ik=1.0))
     batch = synth.run(stream)
     synth.reset()
     poses = [synth.step(TrackingFrame.from_stream(stream, i)) for i in range(stream.n_samples)]

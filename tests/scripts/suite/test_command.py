@@ -76,8 +76,8 @@ def test_regression_flags_exactly_the_worse_metrics(tmp_path, monkeypatch):
 
     make = synthesis_stage.make_synthesizer
 
-    def worse(method, ctx, height):
-        synth = make(method, ctx, height)
+    def worse(method, inputs):
+        synth = make(method, inputs)
         plain = synth.run
         synth.run = lambda stream: corrupt.add_jitter(plain(stream), np.random.default_rng(0), 0.05)
         return synth

@@ -7,7 +7,6 @@ import numpy as np
 import pytest
 
 from render_cams import VRSetup
-from synthesis.coolmoves import Options
 from synthesis.evaluate import (
     EvaluationError,
     Fold,
@@ -16,6 +15,7 @@ from synthesis.evaluate import (
     run_protocol,
     summarise,
 )
+from synthesis.methods import METHODS
 
 
 def test_summary_is_the_mean_over_trials_and_the_pooled_rate():
@@ -61,8 +61,8 @@ def test_alignment_and_turned_copies_help_a_user_facing_away():
     the search matches within 22.5 deg, which the alignment still refines."""
     trials = builtin_trials(("box",), n_subjects=2, n_takes=1, duration_s=3.0, seed=3)
     fold = Fold("box", "1", [trials[0]], [trials[1]])
-    plain = evaluate_fold(fold, Options(), VRSetup(), heading_deg=180.0)[0]["ablation"]
-    copies = evaluate_fold(fold, Options(), VRSetup(), heading_deg=180.0, db_headings=8)
+    plain = evaluate_fold(fold, METHODS["coolmoves"], VRSetup(), heading_deg=180.0)[0]["ablation"]
+    copies = evaluate_fold(fold, METHODS["coolmoves"], VRSetup(), heading_deg=180.0, db_headings=8)
     copies = copies[0]["ablation"]
     assert plain["alignment_no_smoothing"] < 0.5 * plain["no_alignment_no_smoothing"]
     assert copies["no_alignment_no_smoothing"] < 0.5 * plain["no_alignment_no_smoothing"]

@@ -1,0 +1,176 @@
+"""One leaderboard: every registered synthesis method on the same test motions, scored for
+accuracy, for the physics of its output and for speed (``avatarsim eval leaderboard``).
+
+Per fold of the protocol (:func:`synthesis.evaluate.folds`): the database of the fold's
+training trials (built once, shared by every CoolMoves variant), the distance threshold
+chosen on the training data (:mod:`synthesis.evaluate.validation`), and per test trial one
+VR stream that every method (:data:`synthesis.methods.METHODS`) runs on, through
+:func:`scripts.method_score.score_method` (timed ``step`` calls included). A method's numbers
+are means over the trials of a class, then over classes (each class counts once, as the
+paper averages over activities); latency percentiles are those of all steps of a trial,
+averaged likewise.
+"""
+
+from __future__ import annotations
+
+import html
+from collections.abc import Callable, Sequence
+from functools import cache
+from pathlib import Path
+
+import numpy as np
+
+from avatar_models.measure import standing_height
+from render_cams import VRSetup
+from scripts.method_score import score_method
+from scripts.report_html import image_html, page, table_html
+from sim.thresholds import CheckConfig
+from synthesis.base import SynthesisError
+from synthesis.evaluate import (
+    EvaluationError,
+    Trial,
+    database_for,
+    folds,
+    ik_rig_for,
+)
+from synthesis.evaluate.validation import choose_max_distance
+from synthesis.methods import METHODS, MethodInputs, build
+
+COLUMNS = {
+    "hands_cm": "hands",
+    "upper_cm": "upper",
+    "lower_cm": "lower",
+    "full_cm": "full",
+    "hand_corr": "hand r",
+    "penetration_cm_p95": "pen p95 cm",
+    "skate_cm_s_median": "skate cm/s",
+    "joint_limit_violation_frac": "limits frac",
+    "residual_force_bw_p95": "resid BW p95",
+    "step_ms_p50": "step p50 ms",
+    "step_ms_p99": "step p99 ms",
+}
+"""Leaderboard columns: key in each method's summary -> short header."""
+PHYSICS = (
+    "penetration_cm_p95",
+    "skate_cm_s_median",
+    "joint_limit_violation_frac",
+    "residual_force_bw_p95",
+)
+"""The physics checks of each output in the table (:data:`sim.plausibility.CONTRACT_KEYS`)."""
+
+
+def trial_row(result) -> dict[str, float]:
+    """The :data:`COLUMNS` of one :class:`~scripts.method_score.MethodResult`."""
+    score, row = result.score, result.score.row()
+    out = {f"{g}_cm": v for g, v in score.err_cm.items()}
+    out["hand_corr"] = float(np.mean(list(score.hand_corr.values())))
+    for key in PHYSICS:
+        out[key] = float(result.physics[key])
+    out["step_ms_p50"], out["step_ms_p99"] = row["step_ms_p50"], row["step_ms_p99"]
+    return out
+
+
+def fold_rows(fold, setup: VRSetup, methods: Sequence[str], checks: CheckConfig, tune: bool):
+    """``[(class, method, row)]`` for every test trial of ``fold`` and every method."""
+    coolmoves = METHODS["coolmoves"].options
+    overrides = {}
+    if tune:
+        overrides["max_distance"] = choose_max_distance(fold.train, fold.protocol, coolmoves, setup)
+    database = cache(lambda: database_for(fold.train))
+    out = []
+    for trial in fold.test:
+        stream = setup.sample(trial.motion, seed=trial.seed)
+        rig, calibration = ik_rig_for(database().skeleton, trial.motion, setup)
+        inputs = MethodInputs(
+            database, standing_height(trial.motion), rig, calibration, dict(overrides)
+        )
+        for name in methods:
+            result = score_method(build(name, inputs), trial.motion, stream, checks, True)
+            out.append((trial.cls, name, trial_row(result)))
+    return out
+
+
+def _mean_rows(rows: list[dict]) -> dict[str, float]:
+    return {k: float(np.mean([r[k] for r in rows])) for k in rows[0]}
+
+
+def run_leaderboard(
+    trials: Sequence[Trial],
+    protocol: str,
+    methods: Sequence[str] | None = None,
+    setup: VRSetup | None = None,
+    checks: CheckConfig | None = None,
+    tune: bool = True,
+    progress: Callable[[int, int, str], None] | None = None,
+) -> dict:
+    """Every method of ``methods`` (default: all registered) on the test trials of
+    ``protocol``.
+
+    Returns ``{"protocol", "methods": {name: {column: value}}, "per_class": {class: {name:
+    {column: value}}}, "trials", "failed_folds", "skipped"}``.
+    """
+    methods = list(methods or METHODS)
+    all_folds, skipped = folds(trials, protocol)
+    if not all_folds:
+        raise EvaluationError(f"no class can be evaluated {protocol}: {skipped}")
+    setup, checks = setup or VRSetup(), checks or CheckConfig()
+    rows, failed = [], []
+    for i, fold in enumerate(all_folds):
+        try:
+            rows.extend(fold_rows(fold, setup, methods, checks, tune))
+        except SynthesisError as exc:  # e.g. no training clip passes the correlation filter
+            failed.append({"class": fold.cls, "held_out": fold.held_out, "reason": str(exc)})
+        if progress is not None:
+            progress(i + 1, len(all_folds), f"{fold.cls} / {fold.held_out}")
+    if not rows:
+        raise EvaluationError(f"every fold failed: {failed[:3]}")
+    classes = sorted({c for c, _, _ in rows})
+    per_class = {
+        c: {m: _mean_rows([r for cc, mm, r in rows if cc == c and mm == m]) for m in methods}
+        for c in classes
+    }
+    overall = {m: _mean_rows([per_class[c][m] for c in classes]) for m in methods}
+    return {
+        "protocol": protocol,
+        "methods": overall,
+        "per_class": per_class,
+        "trials": len(rows) // len(methods),
+        "failed_folds": failed,
+        "skipped": skipped,
+        "columns": COLUMNS,
+    }
+
+
+def write_plot(board: dict, path: Path) -> Path:
+    """A PNG: full-body error against residual force, one point per method (accuracy
+    against physical plausibility), with the hand error as the marker size."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    for name, s in board["methods"].items():
+        ax.scatter(s["full_cm"], s["residual_force_bw_p95"], s=30 + 20 * s["hands_cm"])
+        ax.annotate(name, (s["full_cm"], s["residual_force_bw_p95"]), fontsize=8)
+    ax.set_xlabel("full-body error (cm)")
+    ax.set_ylabel("residual force p95 (body weights)")
+    ax.set_title(f"leaderboard, {board['protocol']} (marker size: hand error)")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def render_page(board: dict, plot: Path) -> str:
+    """The leaderboard as a self-contained HTML page (table and plot)."""
+    rows = [
+        [html.escape(name)] + [f"{s[k]:.3g}" for k in COLUMNS]
+        for name, s in board["methods"].items()
+    ]
+    body = (
+        f"<h1>Leaderboard: {html.escape(board['protocol'])}, {board['trials']} test trials</h1>"
+        + table_html(rows, ["method", *COLUMNS.values()])
+        + image_html(plot, "Accuracy against physical plausibility, per method")
+    )
+    return page(f"avatarsim leaderboard {board['protocol']}", body)

@@ -1,0 +1,122 @@
+"""The registry of synthesis methods: one name per method, and how to build it for a user.
+
+Every place that lets a user pick a method by name goes through :data:`METHODS`: the
+``eval`` command and its leaderboard, the scenarios and the benchmarks. So what is called
+``coolmoves`` is the same pipeline everywhere: the paper's (§3.1), hands from the blended
+database poses only. What goes beyond the paper has its own name and is reported beside it.
+
+A builder gets a :class:`MethodInputs` (the training motions' database, built on first use,
+the user's height, and the rig the ground truth is scored on) and returns a fresh
+:class:`~synthesis.base.Synthesizer`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+
+from avatar_models import Skeleton
+from render_cams.vr import Attachment
+from synthesis.base import SynthesisError, Synthesizer
+from synthesis.coolmoves import CoolMoves, Database, Options
+from synthesis.ik_baseline import IKBaseline
+
+
+@dataclass(eq=False)
+class MethodInputs:
+    """What a builder may use.
+
+    Attributes:
+        database: builds the motion database of the training motions (called once, on the
+            first method that needs it).
+        user_height_m: the user's standing height.
+        rig: the rig the ground truth is scored on (the humanoid's: the truth's own rig, or
+            the avatar rig a foreign rig was retargeted onto); the IK baseline drives it.
+        calibration: device-on-joint attachments (hmd, left, right controller) on ``rig``,
+            or None for the nominal ones; a calibration from another rig
+            (:func:`~synthesis.ik_baseline.attachments_on_upright_rig`) is steered by
+            position only (the rigs' hand frames differ).
+        coolmoves: option overrides for every CoolMoves variant (e.g. a scenario's
+            ``foot_contact``), applied on top of the variant's own.
+    """
+
+    database_factory: Callable[[], Database]
+    user_height_m: float
+    rig: Skeleton
+    calibration: Sequence[Attachment] | None = None
+    coolmoves: dict = field(default_factory=dict)
+
+    @cached_property
+    def database(self) -> Database:
+        return self.database_factory()
+
+
+@dataclass(frozen=True)
+class Method:
+    """A registered method: its ``name``, a one-line ``summary`` and its ``build``er; the
+    CoolMoves variants also carry their :class:`~synthesis.coolmoves.Options` (the
+    ablation switches them one at a time)."""
+
+    name: str
+    summary: str
+    build: Callable[[MethodInputs], Synthesizer]
+    options: Options | None = None
+
+
+def coolmoves(name: str, summary: str, options: Options) -> Method:
+    """A CoolMoves variant on the inputs' database, named ``name``."""
+
+    def build(inputs: MethodInputs) -> Synthesizer:
+        synth = CoolMoves(
+            inputs.database, inputs.user_height_m, replace(options, **inputs.coolmoves)
+        )
+        synth.name = name
+        return synth
+
+    return Method(name, summary, build, options)
+
+
+def ik_baseline(inputs: MethodInputs) -> Synthesizer:
+    """The VRIK-like baseline on the scored rig (:class:`~synthesis.ik_baseline.IKBaseline`)."""
+    own = inputs.calibration is None
+    return IKBaseline(inputs.rig, inputs.user_height_m, inputs.calibration, own)
+
+
+METHODS: dict[str, Method] = {
+    m.name: m
+    for m in (
+        coolmoves("coolmoves", "CoolMoves as the paper describes it (§3.1)", Options()),
+        coolmoves(
+            "coolmoves+arm-ik",
+            "CoolMoves, then two-bone arm IK to the tracked controllers (beyond the paper)",
+            Options(arm_ik=1.0),
+        ),
+        coolmoves(
+            "coolmoves-gmm", "CoolMoves with the Gaussian-mixture matcher", Options(matcher="gmm")
+        ),
+        coolmoves(
+            "coolmoves-centroid-align",
+            "CoolMoves aligning about the clouds' centroids (the printed equation)",
+            Options(align_about_centroid=True),
+        ),
+        Method("ik", "VRIK-like full-body IK from headset and controllers (§4.1.1)", ik_baseline),
+    )
+}
+"""Every registered method by name (AvatarGo, MoveBox and ControllerPose join as they land)."""
+
+
+def method(name: str) -> Method:
+    """The registered method ``name``.
+
+    Raises:
+        SynthesisError: no method has that name (the message lists them).
+    """
+    if name not in METHODS:
+        raise SynthesisError(f"unknown method {name!r}; available: {', '.join(METHODS)}")
+    return METHODS[name]
+
+
+def build(name: str, inputs: MethodInputs) -> Synthesizer:
+    """A fresh synthesiser of the registered method ``name`` for ``inputs``."""
+    return method(name).build(inputs)
