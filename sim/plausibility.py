@@ -112,7 +112,7 @@ def check_qpos(
     checks: Sequence[Check] = ALL_CHECKS,
     model: mujoco.MjModel | None = None,
 ) -> PlausibilityReport:
-    """Run ``checks`` on ``qpos (T, nq)`` of ``body`` (e.g. a physics tracking result)."""
+    """Run ``checks`` on ``qpos (T, nq)`` of ``body`` (e.g. a physics control result)."""
     config = config or CheckConfig()
     model = model or body.model
     replay = BodyReplay.run(body, model, qpos, fps, config)

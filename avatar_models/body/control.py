@@ -6,7 +6,7 @@ Physics control computes joint torques itself, so the variant's actuators are mo
 body: the retargeted limbs of real clips overlap (upper arms 4 cm into the chest, calves
 crossing), and contacts between them would push with forces the controller does not know of.
 Self-collision is a check on the reference (:mod:`sim.checks.self_collision`), not something
-to simulate while tracking. Everything else (bodies, inertias, limits, sites) is the body's.
+to simulate under physics control. Everything else (bodies, inertias, limits, sites) is the body's.
 """
 
 from __future__ import annotations

@@ -8,7 +8,7 @@ body17 sites, with joint limits from the model and a weak pull towards the rest 
 residual per frame is the mean site-to-target distance.
 
 With ``level_feet``, stance feet are put flat on the floor and swinging feet clear it
-(:mod:`sim.retarget.feet`) so a physics tracker can walk the reference.
+(:mod:`sim.retarget.feet`) so the physics controller can walk the reference.
 """
 
 from __future__ import annotations
@@ -62,7 +62,7 @@ def retarget(
     motion is already its size. ``model`` is the body's compiled MJCF when the caller has
     it (it is only read). Joint limits of the body hold in the result. ``level_feet`` puts
     stance feet flat on the floor and clears swinging ones (module docstring), for physics
-    tracking; off by default, since it trades fidelity for it (Bandai walk normal_001: mean
+    control; off by default, since it trades fidelity for it (Bandai walk normal_001: mean
     body17 residual 0.03 -> 0.75 cm, p95 2.4 cm), so the physics checks judge the source's own
     contacts. The body is the one ``build_body(result.motion.skeleton)`` gives, so a
     reference levelled for these feet is simulated with the same feet.

@@ -1,10 +1,10 @@
-"""Feet of a retargeted reference that a physics tracker can stand and walk on.
+"""Feet of a retargeted reference that the physics controller can stand and walk on.
 
 Shapes: ``T`` frames, ``nq`` MuJoCo position coordinates; feet ordered (left, right).
 
 Stance feet (:func:`level_stance_feet`): body17 has no foot orientation, so the first IK pass
 leaves a standing foot at whatever pitch joins its ankle and toe targets, often on its toes
-(Bandai: heel box ~2 cm up, toe box ~1 cm into the floor), which a physics tracker cannot stand
+(Bandai: heel box ~2 cm up, toe box ~1 cm into the floor), which the physics controller cannot stand
 on. The whole motion is first moved down by :func:`sole_offset` (the source's standing ankles sit
 higher than the humanoid's, e.g. on a shoe sole); the residual is measured against these
 shifted targets. A second pass then adds, on the frames a foot stands, a flat orientation
@@ -13,7 +13,7 @@ ankle and toe sites at their heights in the rest pose, which stands flat-footed 
 on the other frames no foot site goes below that height (toes dug into the floor at toe-off
 would throw the simulated body up). UHC and PhysDiff clean contact the same way: feet in
 stance are put on the ground before physics. Three more repairs make a reference the
-simulated feet can walk (Bandai walks: the plain tracker's mean time upright from five start
+simulated feet can walk (Bandai walks: the plain controller's mean time upright from five start
 frames went from 0.8 to 2.7 s): the source's standing foot pitch (ankle to toe; Bandai 40 deg
 down, the humanoid 17) is matched before the IK (:func:`match_foot_pitch`), else every frame
 tips the foot toes-down; toe joints bend where their box would dip into the floor
