@@ -1,19 +1,20 @@
-"""Atomic file writes with ordinary permissions, and the one JSON writer.
+"""Atomic file writes with ordinary permissions, and the one JSON and per-frame CSV writers.
 
 Every writer of avatarsim writes to a temporary file beside the target and renames it into
-place (:func:`atomic_file`, :func:`write_atomic`, :func:`write_json`), so a reader never sees
-half a file. ``tempfile.mkstemp`` creates that file with mode
-0600; :func:`atomic_file` gives it the mode a plain ``open()`` would have (0666 less the
-user's umask, 0644 with the usual umask 022) before the rename.
+place (:func:`atomic_file`, :func:`write_atomic`, :func:`write_json`,
+:func:`write_columns_csv`), so a reader never sees half a file. ``tempfile.mkstemp`` creates
+that file with mode 0600; :func:`atomic_file` gives it the mode a plain ``open()`` would have
+(0666 less the user's umask, 0644 with the usual umask 022) before the rename.
 """
 
 from __future__ import annotations
 
+import csv
 import json
 import math
 import os
 import tempfile
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Any
@@ -84,3 +85,13 @@ def write_json(path: str | Path, data: Any) -> Path:
     as their ``str``), indented by 2, ending in a newline."""
     text = json.dumps(json_safe(data), indent=2, allow_nan=False, default=str)
     return write_atomic(path, text + "\n")
+
+
+def write_columns_csv(path: str | Path, columns: Mapping[str, Any]) -> Path:
+    """Write equal-length columns (name -> ``(T,)`` values) as a CSV with a header row, one
+    row per frame, atomically."""
+    with atomic_file(path, "w", newline="") as fh:
+        writer = csv.writer(fh)
+        writer.writerow(columns)
+        writer.writerows(np.column_stack([np.asarray(c, dtype=float) for c in columns.values()]))
+    return Path(path)

@@ -7,12 +7,9 @@ joint limit, how much force the floor cannot explain. Thresholds are drawn as da
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
-import numpy as np
-
-from avatar_models.fileio import write_json
+from avatar_models.fileio import write_columns_csv, write_json
 from sim.plausibility import PlausibilityReport
 
 
@@ -22,12 +19,7 @@ def summary_rows(report: PlausibilityReport) -> list[tuple[str, float, float, bo
 
 
 def write_csv(report: PlausibilityReport, path: Path) -> Path:
-    columns = report.per_frame()
-    with open(path, "w", newline="") as fh:
-        writer = csv.writer(fh)
-        writer.writerow(columns)
-        writer.writerows(np.column_stack([np.asarray(c, dtype=float) for c in columns.values()]))
-    return path
+    return write_columns_csv(path, report.per_frame())
 
 
 def write_plot(report: PlausibilityReport, path: Path) -> Path:

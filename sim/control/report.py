@@ -7,14 +7,12 @@ take (mechanical power), and how much the reference's clock had to bend.
 
 from __future__ import annotations
 
-import csv
-import io
 from pathlib import Path
 
 import numpy as np
 
 from avatar_models.body17 import BODY17
-from avatar_models.fileio import write_json
+from avatar_models.fileio import write_columns_csv, write_json
 from sim.control.controller import ControlResult
 
 
@@ -41,13 +39,7 @@ def per_frame(result: ControlResult) -> dict[str, np.ndarray]:
 
 
 def write_csv(result: ControlResult, path: Path) -> Path:
-    columns = per_frame(result)
-    buffer = io.StringIO()
-    writer = csv.writer(buffer)
-    writer.writerow(columns)
-    writer.writerows(np.column_stack(list(columns.values())).tolist())
-    Path(path).write_text(buffer.getvalue())
-    return Path(path)
+    return write_columns_csv(path, per_frame(result))
 
 
 def write_plot(result: ControlResult, path: Path, title: str) -> Path:
