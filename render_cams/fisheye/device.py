@@ -40,6 +40,7 @@ from render_cams.fisheye.keypoints import (
     world_to_camera,
 )
 from render_cams.fisheye.model import FisheyeModel
+from render_cams.fisheye.pose2d import ControllerPose2D, composite_keypoints, controller_pose2d
 from render_cams.fisheye.records import frame_record
 from render_cams.fisheye.render import FisheyeRenderer
 from render_cams.fisheye.rig import (
@@ -49,6 +50,7 @@ from render_cams.fisheye.rig import (
     controller_cameras,
     inside_body,
 )
+from render_cams.fisheye.stitch import stitch_params
 from render_cams.scene import BodyScene, body_for_motion
 
 CAMERA_RATE_HZ = 30.0
@@ -70,8 +72,11 @@ class FisheyeRecording:
             composited from them).
         records: ``C * T`` frame records (:func:`~render_cams.fisheye.records.frame_record`),
             frame by frame, cameras in rig order within a frame.
-        summary: ``{"frames", "cameras", "fps", "bad_frames", "occluded_frames", "seed",
-            "model"}``; like ``records``, it depends on the motion and seed alone.
+        views: per controller with both cameras, the detector's view of its composite and
+            torso-normal view (:mod:`render_cams.fisheye.pose2d`); empty without a detector.
+        summary: ``{"frames", "cameras", "fps", "bad_frames", "filtered_frames",
+            "occluded_frames", "detector", "composites", "seed", "model"}``; like ``records``,
+            it depends on the motion and seed alone.
         fps_rendered: camera frames rendered per second of wall time (not part of the data).
     """
 
@@ -82,6 +87,7 @@ class FisheyeRecording:
     range_mm: np.ndarray
     filtered: np.ndarray
     records: list[dict[str, Any]]
+    views: dict[str, ControllerPose2D]
     summary: dict[str, Any]
     fps_rendered: float
 
@@ -145,9 +151,10 @@ class FisheyeRig:
         inside = inside_body(body, *sampled.fk(), poses[..., :3, 3])  # (T, C): lens covered
         joints = body17_positions(sampled)  # (T, 17, 3)
         thickness = joint_thickness(body)
-        # The third stream (dark frames) leaves the first two as they were with two.
-        rng_inject, rng_noise, rng_dark = (
-            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)
+        # A stream added later (dark frames, then composite detections) leaves the earlier
+        # ones as they were.
+        rng_inject, rng_noise, rng_dark, rng_views = (
+            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(4)
         )
 
         names = tuple(c.name.replace("/", "-") for c in cameras)
@@ -222,6 +229,20 @@ class FisheyeRig:
                     detection=(detected_px[k], detected[k], detected_conf[k]),
                 )
             )
+        views = {}
+        if self.detector is not None:
+            shape = (n_frames, n_cams, -1)
+            for controller, pair in camera_pairs(cameras).items():
+                params = stitch_params(model, [cameras[c] for c in pair])
+                composite = composite_keypoints(
+                    params,
+                    uv.reshape(*shape, 2)[:, pair],
+                    in_image.reshape(shape)[:, pair],
+                    vis.reshape(shape)[:, pair],
+                    score.reshape(shape)[:, pair],
+                    ~filtered[pair].T,
+                )
+                views[controller] = controller_pose2d(params, self.detector, composite, rng_views)
         # Occluded frames are dark for a reason the injected faults do not cover: the filter
         # is scored on the other frames only.
         clear = ~occluded
@@ -233,10 +254,34 @@ class FisheyeRig:
             "filtered_frames": {name: int(filtered[c].sum()) for c, name in enumerate(names)},
             "occluded_frames": {name: int(occluded[c].sum()) for c, name in enumerate(names)},
             "detector": None if self.detector is None else asdict(self.detector),
+            "composites": {
+                controller: {
+                    "frames_with_person": int(v.composite_detection.detected.any(axis=1).sum()),
+                    "torso_views": int(v.torso.valid.sum()),
+                }
+                for controller, v in views.items()
+            },
             "seed": seed,
             "model": model.as_dict(),
         }
         fps_rendered = n_frames * n_cams / max(elapsed, 1e-9)
         return FisheyeRecording(
-            tuple(cameras), names, model, images, range_mm, filtered, records, summary, fps_rendered
+            tuple(cameras),
+            names,
+            model,
+            images,
+            range_mm,
+            filtered,
+            records,
+            views,
+            summary,
+            fps_rendered,
         )
+
+
+def camera_pairs(cameras: Sequence[ControllerCamera]) -> dict[str, list[int]]:
+    """``{controller: [ring, grip]}`` indices of the controllers that carry two cameras."""
+    by_controller: dict[str, list[int]] = {}
+    for c, camera in enumerate(cameras):
+        by_controller.setdefault(camera.controller, []).append(c)
+    return {k: pair for k, pair in by_controller.items() if len(pair) == 2}
