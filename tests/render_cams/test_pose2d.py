@@ -8,15 +8,18 @@ import numpy as np
 import pytest
 
 from avatar_models.body17 import INDEX
+from avatar_models.formats import load_motion
 from avatar_models.generator import generate
 from avatar_models.rigs import body17_positions
 from render_cams.fisheye.detector import KeypointDetector
+from render_cams.fisheye.device import FisheyeRig
 from render_cams.fisheye.keypoints import confidence, project_joints
 from render_cams.fisheye.model import FisheyeModel
 from render_cams.fisheye.pose2d import composite_keypoints, controller_pose2d
 from render_cams.fisheye.rig import camera_poses, controller_cameras
 from render_cams.fisheye.stitch import stitch_params
 from render_cams.fisheye.torso_view import CORNER_INDICES, apply_homography
+from sim.humanoid import humanoid_for
 
 MODEL = FisheyeModel.from_fov().scaled(0.25)
 EXACT = KeypointDetector(error_scale=0.0, miss_rate=0.0, swap_rate=0.0, confidence_noise=0.0)
@@ -79,3 +82,30 @@ def test_torso_view_comes_from_the_detected_torso_and_is_detected_again(pair):
     assert not np.allclose(noisy.torso.H[ok & valid], exact.torso.H[ok & valid])
     l_hip = INDEX["l_hip"]
     assert np.all(noisy.torso.valid <= noisy.composite_detection.detected[:, l_hip])
+
+
+REAL_CLIPS = {
+    "cmu": ("cmu/09_01.bvh", 0.05),  # a run; frame 0 is a T-pose
+    "bandai-1": ("bandai/dataset-1/data/dataset-1_walk_normal_001.bvh", 1.0),
+    "bandai-2": ("bandai/dataset-2/data/dataset-2_wave-right-hand_normal_001.bvh", 1.0),
+}
+"""Source -> clip and the second a 0.4 s slice of it starts at."""
+
+
+@pytest.mark.mocap
+@pytest.mark.parametrize("source", sorted(REAL_CLIPS))
+def test_real_clip_through_filter_detector_composite_and_torso_view(mocap_dir, source):
+    rel, start_s = REAL_CLIPS[source]
+    motion = load_motion(mocap_dir / rel)
+    first = int(round(start_s * motion.fps))
+    # The humanoid for the clip (its own rig retargeted), as the render command and datasets do.
+    humanoid = humanoid_for(motion[first : first + int(0.4 * motion.fps)])
+    recording = FisheyeRig(scale=0.125).sample(humanoid.motion, 0, humanoid.body)
+    assert sorted(recording.views) == ["left_controller", "right_controller"]
+    detected = np.array([r["detected"] for r in recording.records])
+    shown = np.array([r["in_image"] for r in recording.records])
+    assert detected.any() and detected.sum() <= shown.sum() + 2 * len(recording.records)
+    for view in recording.views.values():
+        found = view.composite_detection.detected
+        assert np.all(np.isfinite(view.composite_detection.uv))
+        assert np.all(view.torso.valid <= found[:, CORNER_INDICES].all(axis=1))
