@@ -40,7 +40,7 @@ from render_cams.fisheye.keypoints import (
     world_to_camera,
 )
 from render_cams.fisheye.model import FisheyeModel
-from render_cams.fisheye.pose2d import ControllerPose2D, composite_keypoints, controller_pose2d
+from render_cams.fisheye.pose2d import ControllerPose2D, controller_views
 from render_cams.fisheye.records import frame_record
 from render_cams.fisheye.render import FisheyeRenderer
 from render_cams.fisheye.rig import (
@@ -50,7 +50,6 @@ from render_cams.fisheye.rig import (
     controller_cameras,
     inside_body,
 )
-from render_cams.fisheye.stitch import stitch_params
 from render_cams.scene import BodyScene, body_for_motion
 
 CAMERA_RATE_HZ = 30.0
@@ -229,20 +228,21 @@ class FisheyeRig:
                     detection=(detected_px[k], detected[k], detected_conf[k]),
                 )
             )
-        views = {}
-        if self.detector is not None:
-            shape = (n_frames, n_cams, -1)
-            for controller, pair in camera_pairs(cameras).items():
-                params = stitch_params(model, [cameras[c] for c in pair])
-                composite = composite_keypoints(
-                    params,
-                    uv.reshape(*shape, 2)[:, pair],
-                    in_image.reshape(shape)[:, pair],
-                    vis.reshape(shape)[:, pair],
-                    score.reshape(shape)[:, pair],
-                    ~filtered[pair].T,
-                )
-                views[controller] = controller_pose2d(params, self.detector, composite, rng_views)
+        views = (
+            {}
+            if self.detector is None
+            else controller_views(
+                model,
+                cameras,
+                uv.reshape(n_frames, n_cams, 17, 2),
+                in_image.reshape(n_frames, n_cams, 17),
+                vis.reshape(n_frames, n_cams, 17),
+                score.reshape(n_frames, n_cams, 17),
+                ~filtered.T,
+                self.detector,
+                rng_views,
+            )
+        )
         # Occluded frames are dark for a reason the injected faults do not cover: the filter
         # is scored on the other frames only.
         clear = ~occluded
@@ -277,11 +277,3 @@ class FisheyeRig:
             summary,
             fps_rendered,
         )
-
-
-def camera_pairs(cameras: Sequence[ControllerCamera]) -> dict[str, list[int]]:
-    """``{controller: [ring, grip]}`` indices of the controllers that carry two cameras."""
-    by_controller: dict[str, list[int]] = {}
-    for c, camera in enumerate(cameras):
-        by_controller.setdefault(camera.controller, []).append(c)
-    return {k: pair for k, pair in by_controller.items() if len(pair) == 2}

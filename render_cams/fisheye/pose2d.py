@@ -14,12 +14,15 @@ estimates"). No view where the detector did not report all four torso corners.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from render_cams.fisheye.detector import Detection, KeypointDetector
-from render_cams.fisheye.stitch import StitchParams
+from render_cams.fisheye.model import FisheyeModel
+from render_cams.fisheye.rig import ControllerCamera, camera_pairs
+from render_cams.fisheye.stitch import StitchParams, stitch_params
 from render_cams.fisheye.torso_view import TorsoView, apply_homography, torso_view
 
 
@@ -46,6 +49,7 @@ class ControllerPose2D:
     """The detector's view of one controller over ``T`` frames.
 
     Attributes:
+        params: the pair's stitch parameters (the composite's geometry).
         composite: exact joints in the composite.
         composite_detection: what the detector reported on the composite.
         torso: ``(T,)`` torso-normal views built from ``composite_detection``.
@@ -53,6 +57,7 @@ class ControllerPose2D:
         torso_detection: what the detector reported in the torso view.
     """
 
+    params: StitchParams
     composite: CompositeKeypoints
     composite_detection: Detection
     torso: TorsoView
@@ -115,4 +120,34 @@ def controller_pose2d(
     cyl = params.cylinder
     in_view = view.valid[:, None] & composite.in_image & inside(torso_uv, cyl.width, cyl.height)
     again = detector.detect(torso_uv, in_view, composite.visible, composite.score, rng)
-    return ControllerPose2D(composite, detection, view, torso_uv, again)
+    return ControllerPose2D(params, composite, detection, view, torso_uv, again)
+
+
+def controller_views(
+    model: FisheyeModel,
+    cameras: Sequence[ControllerCamera],
+    uv: np.ndarray,
+    in_image: np.ndarray,
+    visible: np.ndarray,
+    score: np.ndarray,
+    usable: np.ndarray,
+    detector: KeypointDetector,
+    rng: np.random.Generator,
+) -> dict[str, ControllerPose2D]:
+    """:func:`controller_pose2d` of every controller with two of ``cameras`` (lens
+    ``model``), from every camera's exact pixels ``uv`` ``(T, C, 17, 2)``, ``in_image``,
+    ``visible`` ``(T, C, 17)`` bool, ``score`` ``(T, C, 17)`` and ``usable`` ``(T, C)`` bool
+    (passed the image filter)."""
+    views = {}
+    for controller, pair in camera_pairs(cameras).items():
+        params = stitch_params(model, [cameras[c] for c in pair])
+        composite = composite_keypoints(
+            params,
+            uv[:, pair],
+            in_image[:, pair],
+            visible[:, pair],
+            score[:, pair],
+            usable[:, pair],
+        )
+        views[controller] = controller_pose2d(params, detector, composite, rng)
+    return views

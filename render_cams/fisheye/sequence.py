@@ -27,9 +27,10 @@ import cv2
 import imageio.v2 as imageio
 import numpy as np
 
-from render_cams.fisheye.device import FisheyeRecording, camera_pairs
+from render_cams.fisheye.device import FisheyeRecording
 from render_cams.fisheye.pose2d import ControllerPose2D
 from render_cams.fisheye.records import detection_fields
+from render_cams.fisheye.rig import camera_pairs
 from render_cams.fisheye.stitch import stitch_params
 
 
@@ -78,10 +79,14 @@ def _write_stitched(recording: FisheyeRecording, out: Path) -> list[str]:
     folders = []
     cameras, images = recording.cameras, recording.images
     for controller, pair in camera_pairs(cameras).items():
-        params = stitch_params(recording.model, [cameras[c] for c in pair])
+        view = recording.views.get(controller)
+        params = (
+            stitch_params(recording.model, [cameras[c] for c in pair])
+            if view is None
+            else view.params
+        )
         folder = out / "stitched" / controller
         folder.mkdir(parents=True, exist_ok=True)
-        view = recording.views.get(controller)
         if view is not None:
             (out / "torso" / controller).mkdir(parents=True, exist_ok=True)
         for t in range(images.shape[1]):

@@ -23,7 +23,7 @@ from render_cams.fisheye.detector import KeypointDetector
 from render_cams.fisheye.device import FisheyeRig
 from render_cams.fisheye.keypoints import confidence, project_joints
 from render_cams.fisheye.model import FisheyeModel
-from render_cams.fisheye.pose2d import composite_keypoints, controller_pose2d
+from render_cams.fisheye.pose2d import controller_views
 from render_cams.fisheye.render import FisheyeRenderer
 from render_cams.fisheye.rig import camera_poses, controller_cameras
 from render_cams.fisheye.stitch import stitch_params
@@ -75,8 +75,7 @@ def detector_rows(quick: bool) -> list[BenchRow]:
     rng = np.random.default_rng(0)
     per_camera, on_composite, in_torso, missed, swapped, sizes = [], [], [], [], [], []
     cameras = controller_cameras()
-    params = {k: stitch_params(model, cameras[2 * k : 2 * k + 2]) for k in range(len(cameras) // 2)}
-    for activity in ("box", "squat", "balance"):
+    for activity in ("box", "squat", "controllerpose_study"):
         motion = generate(activity, duration_s=1.0 if quick else 4.0, fps=30)
         poses = camera_poses(motion, cameras)
         n, c = poses.shape[:2]
@@ -90,20 +89,13 @@ def detector_rows(quick: bool) -> list[BenchRow]:
         sizes.append(detection.scale_px[detection.scale_px > 0])
         missed.append(1.0 - detection.detected[in_image].mean())
         swapped.append(detection.swapped[detection.scale_px > 0].mean())
-        for k, pair_params in params.items():
-            pair = slice(2 * k, 2 * k + 2)
-            usable = np.ones((n, 2), bool)
-            composite = composite_keypoints(
-                pair_params,
-                uv[:, pair],
-                in_image[:, pair],
-                in_image[:, pair],
-                score[:, pair],
-                usable,
-            )
-            views = controller_pose2d(pair_params, detector, composite, rng)
-            on_composite.append(_errors(views.composite_detection, composite.uv))
-            in_torso.append(_errors(views.torso_detection, views.torso_uv))
+        usable = np.ones((n, c), bool)
+        views = controller_views(
+            model, cameras, uv, in_image, in_image, score, usable, detector, rng
+        )
+        for view in views.values():
+            on_composite.append(_errors(view.composite_detection, view.composite.uv))
+            in_torso.append(_errors(view.torso_detection, view.torso_uv))
     rows = []
     for label, errors in (
         ("per camera", per_camera),
