@@ -14,7 +14,8 @@ x 22 cm" (§5.1): per hand, a group of four at each of two distances, fully outs
 with the elbows bent (22 cm nearer). Each group: straight ahead at shoulder height, at head
 height, to the side at shoulder height, at stomach height (51 cm from head to stomach
 height: 25 cm above the shoulder, 26 below); the side spheres of the two hands are 69 cm
-apart, the ahead ones in front of their shoulders. One controller at a time moves "between
+apart, the ahead ones in front of their shoulders; they move and pitch with the chest (a squat or a
+hip hinge carries them along). One controller at a time moves "between
 these four points, pausing momentarily at each sphere ... straight, up, side, down, back to
 straight ... ~3 seconds" at "a mean translation speed of 1.1 m/s"; here it travels between
 spheres at 1.1 m/s (minimum-jerk) and pauses for the rest of each 3 s loop. The groups follow
@@ -32,7 +33,7 @@ import numpy as np
 from avatar_models.generator.curves import keyframes, smoothstep
 from avatar_models.generator.feet import FootTrack
 from avatar_models.generator.ik import axis_rotation
-from avatar_models.generator.plan import LimbTarget, Plan, Scene
+from avatar_models.generator.plan import LimbTarget, Plan, Scene, realise
 from avatar_models.generator.poses import Y_AXIS, gaze, heading_rotation, trunk
 from avatar_models.generator.standing import home_ankles, leg_targets, reachable_root
 
@@ -89,12 +90,12 @@ STUDY_POSES: tuple[StudyPose, ...] = (
     StudyPose("stand"),
     StudyPose("wide_stance", (0.0, 0.06, 0.0), (0.0, -0.06, 0.0), drop=0.03),
     StudyPose("half_squat", (0.0, 0.03, 0.0), (0.0, -0.03, 0.0), drop=0.18, hinge_deg=15.0),
-    StudyPose("deep_squat", (0.0, 0.04, 0.0), (0.0, -0.04, 0.0), drop=0.32, hinge_deg=25.0),
+    StudyPose("deep_squat", (0.0, 0.04, 0.0), (0.0, -0.04, 0.0), drop=0.3, hinge_deg=20.0),
     StudyPose("hip_hinge", drop=0.05, hinge_deg=35.0),
     *_both_sides("lunge", (0.16, 0.0, 0.0), (-0.12, 0.0, 0.0), drop=0.2),
     *_both_sides("side_lunge", (0.0, 0.14, 0.0), (0.0, -0.02, 0.0), drop=0.15),
     *_both_sides("split_stance", (0.1, 0.0, 0.0), (-0.1, 0.0, 0.0), drop=0.06),
-    StudyPose("narrow_stance", (0.0, -0.04, 0.0), (0.0, 0.04, 0.0)),
+    StudyPose("narrow_stance", (0.0, -0.015, 0.0), (0.0, 0.015, 0.0)),
     *_both_sides(
         "knee_raise", (0.1, 0.0, 0.22), (0.0, 0.0, 0.0), lifted=True, lifted_pitch_deg=25.0
     ),
@@ -221,30 +222,16 @@ def controllerpose_study(scene: Scene) -> Plan:
     root[:, 0] -= 0.2 * np.sin(hinge) * scene.leg_length  # the hips go back as the trunk leans
     pelvis = axis_rotation(Y_AXIS, np.full(n, 0.5 * hinge))
     root = reachable_root(scene, root, pelvis, feet)
-    # The spheres are locked to the body: they follow the root from its standing place.
-    body_shift = root - [0.0, 0.0, scene.skeleton.offsets[0, 2]]
     targets, active, group = sweep(scene)
-    joints = {**toes}
-    arms = {}
-    for side in "LR":
-        # At rest the hand hangs a little in front of the thigh, the elbow slightly bent.
-        shoulder = scene.rest(f"Bip01 {side} UpperArm")
-        arm = np.linalg.norm(scene.rest(f"Bip01 {side} Hand") - shoulder)
-        sign = 1.0 if side == "L" else -1.0
-        rest_hand = shoulder + arm * np.array(REST_HAND) * [1.0, sign, 1.0]
-        wrist = rest_hand + active[side][:, None] * (targets[side] - rest_hand) + body_shift
-        pole = np.broadcast_to([0.0, 1.0 if side == "L" else -1.0, -1.0], (n, 3))
-        arms[side] = LimbTarget(wrist, pole)
-    return Plan(
+    plan = Plan(
         root_pos=root,
         root_rot=heading_rotation(0.0, n),
         pelvis=pelvis,
         spine=trunk(scene, 0.5 * hinge),
         head=gaze(scene, 0.0, np.radians(10.0)),
         contacts=np.stack([feet[s].contact for s in "LR"], axis=1),
-        joints=joints,
+        joints=toes,
         legs=legs,
-        arms=arms,
         fist=np.full((n, 2), 0.6),  # holding the controllers
         meta={
             "study_pose": pose.name,
@@ -253,3 +240,19 @@ def controllerpose_study(scene: Scene) -> Plan:
             "group_per_frame": group.astype(np.int8),
         },
     )
+    # The spheres are locked to the front of the body: they move and pitch with the chest,
+    # which the legs and trunk of the plan place (realised once without the arms).
+    positions, rotations = realise(scene, plan).fk()
+    chest = rotations[:, scene.skeleton.index("Bip01 Spine2")]  # (T, 3, 3), identity at rest
+    for side in "LR":
+        # At rest the hand hangs a little in front of the thigh, the elbow slightly bent.
+        rest_shoulder = scene.rest(f"Bip01 {side} UpperArm")
+        arm = np.linalg.norm(scene.rest(f"Bip01 {side} Hand") - rest_shoulder)
+        sign = 1.0 if side == "L" else -1.0
+        rest_hand = rest_shoulder + arm * np.array(REST_HAND) * [1.0, sign, 1.0]
+        wrist = rest_hand + active[side][:, None] * (targets[side] - rest_hand)
+        shoulder = positions[:, scene.skeleton.index(f"Bip01 {side} UpperArm")]
+        wrist = shoulder + np.einsum("tab,tb->ta", chest, wrist - rest_shoulder)
+        pole = np.einsum("tab,b->ta", chest, [0.0, sign, -1.0])  # elbow out and down
+        plan.arms[side] = LimbTarget(wrist, pole)
+    return plan
