@@ -8,8 +8,8 @@ Layout of ``out_dir``:
   no timings or absolute paths, so that the same motion and seed give the same bytes in any
   folder;
 - ``stitched/<controller>/NNNNNN.png``: each controller's two cameras on one cylinder, from
-  the frames the image filter kept (a dropped frame leaves its camera's part black; no file
-  when both were dropped);
+  the frames the image filter kept (a dropped frame leaves its camera's part black, both
+  dropped a black composite);
 - ``torso/<controller>/NNNNNN.png``: the torso-normal view of that composite, where the
   detector reported both shoulders and hips;
 - ``views.json``: per controller and frame, the detector's keypoints on the composite and in
@@ -91,8 +91,6 @@ def _write_stitched(recording: FisheyeRecording, out: Path) -> list[str]:
             (out / "torso" / controller).mkdir(parents=True, exist_ok=True)
         for t in range(images.shape[1]):
             usable = ~recording.filtered[pair, t]
-            if not usable.any():
-                continue
             composite = params.stitch([images[c, t] for c in pair], usable)
             cv2.imwrite(str(folder / f"{t:06d}.png"), composite[..., ::-1])
             if view is not None and view.torso.valid[t]:

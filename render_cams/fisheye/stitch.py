@@ -252,16 +252,47 @@ def stitch_params(
     max_half_width_deg: float = MAX_HALF_WIDTH_DEG,
 ) -> StitchParams:
     """The one-time stitch parameters of a controller's two ``cameras`` (the ring and grip
-    cameras of :func:`~render_cams.fisheye.rig.controller_cameras`) with lens ``model``."""
+    cameras of :func:`~render_cams.fisheye.rig.controller_cameras`) with lens ``model``.
+
+    Computed once per lens, mount and cylinder in a process (seconds at 640 x 480: a
+    projection of every composite pixel into both cameras) and shared after: treat the
+    arrays as read-only."""
     if len(cameras) != 2:
         raise ValueError(f"stitching joins two cameras, got {len(cameras)}")
+    key = (
+        model.K.tobytes(),
+        model.D.tobytes(),
+        model.width,
+        model.height,
+        tuple((c.position.tobytes(), c.axes.tobytes()) for c in cameras),
+        float(radius_m),
+        float(max_half_width_deg),
+    )
+    if key not in _STITCH_CACHE:
+        if len(_STITCH_CACHE) >= STITCH_CACHE_SIZE:
+            _STITCH_CACHE.pop(next(iter(_STITCH_CACHE)))  # the oldest
+        _STITCH_CACHE[key] = compute_stitch_params(model, cameras, radius_m, max_half_width_deg)
+    return _STITCH_CACHE[key]
+
+
+STITCH_CACHE_SIZE = 4  # both controllers of two lenses; about 35 MB each at 640 x 480
+_STITCH_CACHE: dict[tuple, StitchParams] = {}
+
+
+def compute_stitch_params(
+    model: FisheyeModel,
+    cameras: Sequence[ControllerCamera],
+    radius_m: float,
+    max_half_width_deg: float,
+) -> StitchParams:
+    """:func:`stitch_params` without the cache."""
     cylinder = stitch_cylinder(model, cameras, radius_m, max_half_width_deg)
     to_cylinder = np.linalg.inv(cylinder.pose)
     poses = np.stack([to_cylinder @ camera_pose(c) for c in cameras])
     v, u = np.mgrid[0 : cylinder.height, 0 : cylinder.width].astype(np.float64)
     surface = cylinder.surface(np.stack([u, v], axis=-1))
     # Surface points in each camera frame: R^T (p - t).
-    in_camera = np.einsum("cba,chwb->chwa", poses[:, :3, :3], surface - poses[:, None, None, :3, 3])
+    in_camera = (surface - poses[:, None, None, :3, 3]) @ poses[:, None, :3, :3]
     uv, valid = model.project(in_camera)
     uv = np.where(valid[..., None], uv, -1.0).astype(np.float32)
     # The camera whose optical axis points further up (-y) takes the top of the overlap.
