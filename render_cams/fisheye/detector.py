@@ -5,8 +5,9 @@ Per frame, vectorised over any leading axes (frames, cameras), for ``body17`` ke
 
 - **Person size** ``s``: the square root of the area of the box round the keypoints inside
   the image, in pixels. COCO's keypoint metric (OKS) scales errors by the square root of the
-  person's segment area; the keypoints' box is a close stand-in (the keypoints sit inside the
-  silhouette, which is about half its own box). Fewer than :data:`MIN_PERSON_JOINTS` keypoints
+  person's segment area; the keypoints' box stands in for it (it is smaller than the
+  person's box, the segment smaller than that box: an assumption that the two roughly
+  cancel, absorbed by ``error_scale``). Fewer than :data:`MIN_PERSON_JOINTS` keypoints
   in the image: no person is found and nothing is reported (§4.3: "in cases where no
   skeletons are found, the pipeline ends here").
 - **Localisation error**: isotropic Gaussian, per-axis standard deviation
@@ -14,11 +15,13 @@ Per frame, vectorised over any leading axes (frames, cameras), for ``body17`` ke
   ``sigma_i`` are COCO's per-keypoint OKS constants (Lin et al., "Microsoft COCO", 2014;
   cocodataset.org/#keypoints-eval: the standard deviation of human annotators' clicks over the
   object scale, from 5000 redundantly annotated images), :data:`COCO_SIGMAS`; the foot keypoint
-  takes COCO-WholeBody's big-toe constant (Jin et al., ECCV 2020). ``error_scale`` is how much
+  takes the mean of COCO-WholeBody's two big-toe constants (Jin et al., ECCV 2020; 0.068 and
+  0.092 as mmpose's ``coco_wholebody`` config lists them). ``error_scale`` is how much
   worse than an annotator the detector is: with per-axis ``c sigma_i s`` the expected OKS term
   ``exp(-d^2 / (2 s^2 (2 sigma_i)^2))`` is ``1 / (1 + c^2 / 4)``; the default ``c = 1.5`` gives
-  0.64, the level of OpenPose's COCO test-dev AP of 61.8 (Cao et al., TPAMI 2019, the detector
-  ControllerPose uses). A calibration choice, not a measurement on fisheye images.
+  0.64, the level of the part-affinity-field method's 61.8 AP on COCO test-dev (Cao et al.,
+  CVPR 2017; it became OpenPose, the detector ControllerPose uses). A calibration choice, not a
+  measurement on fisheye images.
 - **Missed joints at low visibility**: a joint in the image is dropped with probability
   ``miss_rate * (1 - v)``, ``v`` its visibility score in ``[0, 1]``
   (:func:`render_cams.fisheye.keypoints.confidence`: 1 at the image centre, 0.5 at the image
@@ -43,7 +46,7 @@ from avatar_models.body17 import BODY17, INDEX
 from render_cams.device import DeviceError
 
 # COCO keypoint OKS sigmas (cocoapi, pycocotools/cocoeval.py) by COCO keypoint name, plus
-# COCO-WholeBody's big toe.
+# the mean of COCO-WholeBody's left and right big toe (0.068, 0.092).
 COCO_SIGMAS: dict[str, float] = {
     "nose": 0.026,
     "eye": 0.025,
@@ -54,7 +57,7 @@ COCO_SIGMAS: dict[str, float] = {
     "hip": 0.107,
     "knee": 0.087,
     "ankle": 0.089,
-    "big_toe": 0.068,
+    "big_toe": 0.080,
 }
 # The COCO keypoint each body17 joint is scored as: OpenPose's BODY_25 builds its neck and
 # mid-hip from the shoulders and hips, so they take those constants; the head is the nose.
