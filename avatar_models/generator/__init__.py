@@ -16,7 +16,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from avatar_models.errors import MotionValueError
-from avatar_models.generator import boxing, exercises, ladder, locomotion, swim
+from avatar_models.generator import boxing, exercises, ladder, locomotion, study, swim
 from avatar_models.generator.plan import Plan, Scene, realise
 from avatar_models.generator.subject import STYLES, Style, Subject, sample_subject, subject_skeleton
 from avatar_models.motion import Motion
@@ -33,6 +33,7 @@ _ACTIVITY_PLANS: dict[str, Callable[[Scene], Plan]] = {
     "lunge": exercises.lunge,
     "kick": exercises.kick,
     "balance": exercises.balance,
+    "controllerpose_study": study.controllerpose_study,
 }
 ACTIVITIES: tuple[str, ...] = tuple(_ACTIVITY_PLANS)
 

@@ -6,17 +6,22 @@ with bad frames injected (§4.2, about 1 in 50) when ``bad_frame_rate > 0``, the
 each pixel's ray, and one self-describing record per camera frame
 (:mod:`render_cams.fisheye.records`), incl. the bad-frame ground truth and the occlusion flags
 (a camera inside or against the body records a dark frame, :mod:`render_cams.fisheye.occlusion`).
+Then, as the real pipeline does (§4.2-4.3), an image-only filter drops unusable frames
+(:func:`render_cams.fisheye.bad_frames.detect`, on the pixels, not on the injection flag) and a
+2D keypoint detector (:class:`render_cams.fisheye.detector.KeypointDetector`, on by default)
+reports keypoints on the frames that pass. Records keep the exact projections
+(``keypoints_px``, for re-projection) next to what the detector reported (``detected_px``).
 :func:`render_cams.fisheye.sequence.write_fisheye_recording` writes a recording to a folder.
 
 Everything random comes from one seed, split with ``numpy.random.SeedSequence`` into bad-frame
-injection, detector noise and dark frames.
+injection, detector errors and dark frames.
 """
 
 from __future__ import annotations
 
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -26,8 +31,8 @@ from avatar_models.body import BodyDescription
 from avatar_models.rigs import body17_positions
 from render_cams.device import DeviceError, check_rate, motion_at_rate, resolve_seed
 from render_cams.fisheye import bad_frames, occlusion
+from render_cams.fisheye.detector import KeypointDetector
 from render_cams.fisheye.keypoints import (
-    DetectorNoise,
     confidence,
     joint_thickness,
     project_joints,
@@ -35,6 +40,7 @@ from render_cams.fisheye.keypoints import (
     world_to_camera,
 )
 from render_cams.fisheye.model import FisheyeModel
+from render_cams.fisheye.pose2d import ControllerPose2D, controller_views
 from render_cams.fisheye.records import frame_record
 from render_cams.fisheye.render import FisheyeRenderer
 from render_cams.fisheye.rig import (
@@ -61,10 +67,15 @@ class FisheyeRecording:
         images: ``(C, T, H, W, 3)`` uint8 RGB as recorded (bad frames injected, dark when
             occluded).
         range_mm: ``(C, T, H, W)`` uint16 range along each pixel's ray in millimetres (0: none).
+        filtered: ``(C, T)`` bool: frames the image filter dropped (nothing is detected or
+            composited from them).
         records: ``C * T`` frame records (:func:`~render_cams.fisheye.records.frame_record`),
             frame by frame, cameras in rig order within a frame.
-        summary: ``{"frames", "cameras", "fps", "bad_frames", "occluded_frames", "seed",
-            "model"}``; like ``records``, it depends on the motion and seed alone.
+        views: per controller with both cameras, the detector's view of its composite and
+            torso-normal view (:mod:`render_cams.fisheye.pose2d`); empty without a detector.
+        summary: ``{"frames", "cameras", "fps", "bad_frames", "filtered_frames",
+            "occluded_frames", "detector", "composites", "seed", "model"}``; like ``records``,
+            it depends on the motion and seed alone.
         fps_rendered: camera frames rendered per second of wall time (not part of the data).
     """
 
@@ -73,7 +84,9 @@ class FisheyeRecording:
     model: FisheyeModel
     images: np.ndarray
     range_mm: np.ndarray
+    filtered: np.ndarray
     records: list[dict[str, Any]]
+    views: dict[str, ControllerPose2D]
     summary: dict[str, Any]
     fps_rendered: float
 
@@ -88,7 +101,7 @@ class FisheyeRig:
         scale: image size factor in :data:`SCALE_RANGE`, for quick looks.
         rate_hz: frame rate of every camera.
         bad_frame_rate: share of frames corrupted (interference, sync loss).
-        detector_noise: noise on the 2D keypoints of the records (None: exact).
+        detector: the 2D keypoint detector's error model (None: report exact projections).
         controllers: controllers that carry cameras (two each, ring and grip).
         mount: where the cameras sit on a controller (default :class:`Mount`).
     """
@@ -97,7 +110,7 @@ class FisheyeRig:
     scale: float = 1.0
     rate_hz: float = CAMERA_RATE_HZ
     bad_frame_rate: float = bad_frames.BAD_FRAME_RATE
-    detector_noise: DetectorNoise | None = None
+    detector: KeypointDetector | None = KeypointDetector()
     controllers: Sequence[str] = ("left_controller", "right_controller")
     mount: Mount | None = None
     name: str = "fisheye"
@@ -137,9 +150,10 @@ class FisheyeRig:
         inside = inside_body(body, *sampled.fk(), poses[..., :3, 3])  # (T, C): lens covered
         joints = body17_positions(sampled)  # (T, 17, 3)
         thickness = joint_thickness(body)
-        # The third stream (dark frames) leaves the first two as they were with two.
-        rng_inject, rng_noise, rng_dark = (
-            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(3)
+        # A stream added later (dark frames, then composite detections) leaves the earlier
+        # ones as they were.
+        rng_inject, rng_noise, rng_dark, rng_views = (
+            np.random.default_rng(s) for s in np.random.SeedSequence(seed).spawn(4)
         )
 
         names = tuple(c.name.replace("/", "-") for c in cameras)
@@ -174,14 +188,26 @@ class FisheyeRig:
         truth = np.zeros((n_cams, n_frames), bool)
         for c in range(n_cams):
             images[c], truth[c], _ = bad_frames.inject(images[c], rng_inject, self.bad_frame_rate)
+        filtered = np.stack([bad_frames.detect(images[c]) for c in range(n_cams)])  # (C, T)
         occluded = blocked >= occlusion.OCCLUDED_FRACTION  # (C, T)
         w2c = world_to_camera(poses)
+        uv, in_image, vis = (np.stack([s[k] for s in seen]) for k in (2, 3, 4))  # (T * C, ...)
+        score = confidence(model, uv, vis)
+        usable = ~filtered.T.reshape(-1)  # frame-major, as ``seen``
+        # Filtered frames are dropped before detection: no keypoint of theirs is reported.
+        reported = in_image & usable[:, None]
+        if self.detector is None:
+            detected = reported
+            detected_px, detected_conf = np.where(detected[..., None], uv, 0.0), score * detected
+        else:
+            detection = self.detector.detect(uv, reported, vis, score, rng_noise)
+            detected_px, detected, detected_conf = (
+                detection.uv,
+                detection.detected,
+                detection.confidence,
+            )
         records = []
-        for t, c, uv, in_image, vis in seen:
-            conf = confidence(model, uv, vis)
-            if self.detector_noise is not None:
-                uv, detected, conf = self.detector_noise.apply(uv, vis, conf, rng_noise)
-                in_image = in_image & detected
+        for k, (t, c, *_) in enumerate(seen):
             records.append(
                 frame_record(
                     names[c],
@@ -190,30 +216,64 @@ class FisheyeRig:
                     t / self.rate_hz,
                     w2c[t, c],
                     joints[t],
-                    uv,
-                    in_image,
-                    vis,
-                    conf,
+                    uv[k],
+                    in_image[k],
+                    vis[k],
+                    score[k],
                     bad_frame=bool(truth[c, t]),
                     lens_blocked=blocked[c, t],
                     occluded=bool(occluded[c, t]),
                     mean_luminance=occlusion.mean_luminance(images[c, t], circle),
+                    filtered=bool(filtered[c, t]),
+                    detection=(detected_px[k], detected[k], detected_conf[k]),
                 )
             )
-        flagged = np.stack([bad_frames.detect(images[c]) for c in range(n_cams)])
-        # Occluded frames are dark for a reason the injected faults do not cover: the detector
+        views = (
+            {}
+            if self.detector is None
+            else controller_views(
+                model,
+                cameras,
+                uv.reshape(n_frames, n_cams, 17, 2),
+                in_image.reshape(n_frames, n_cams, 17),
+                vis.reshape(n_frames, n_cams, 17),
+                score.reshape(n_frames, n_cams, 17),
+                ~filtered.T,
+                self.detector,
+                rng_views,
+            )
+        )
+        # Occluded frames are dark for a reason the injected faults do not cover: the filter
         # is scored on the other frames only.
         clear = ~occluded
         summary = {
             "frames": int(n_frames),
             "cameras": list(names),
             "fps": self.rate_hz,
-            "bad_frames": bad_frames.precision_recall(truth[clear], flagged[clear]),
+            "bad_frames": bad_frames.precision_recall(truth[clear], filtered[clear]),
+            "filtered_frames": {name: int(filtered[c].sum()) for c, name in enumerate(names)},
             "occluded_frames": {name: int(occluded[c].sum()) for c, name in enumerate(names)},
+            "detector": None if self.detector is None else asdict(self.detector),
+            "composites": {
+                controller: {
+                    "frames_with_person": int(v.composite_detection.detected.any(axis=1).sum()),
+                    "torso_views": int(v.torso.valid.sum()),
+                }
+                for controller, v in views.items()
+            },
             "seed": seed,
             "model": model.as_dict(),
         }
         fps_rendered = n_frames * n_cams / max(elapsed, 1e-9)
         return FisheyeRecording(
-            tuple(cameras), names, model, images, range_mm, records, summary, fps_rendered
+            tuple(cameras),
+            names,
+            model,
+            images,
+            range_mm,
+            filtered,
+            records,
+            views,
+            summary,
+            fps_rendered,
         )

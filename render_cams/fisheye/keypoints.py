@@ -1,4 +1,4 @@
-"""``body17`` 2D keypoints of a fisheye camera: projection, visibility, confidence, noise.
+"""``body17`` 2D keypoints of a fisheye camera: projection, visibility, visibility score.
 
 Projection uses the camera's own model (:meth:`FisheyeModel.project`, equal to
 ``cv2.fisheye.projectPoints``), vectorised over frames and joints. A joint is *visible* when it
@@ -9,17 +9,15 @@ body, is in front of it.
 
 Confidence is a heuristic of what a 2D detector reports (ControllerPose §4.3 feeds OpenPose
 confidences to its network): 1 at the image centre falling to 0.5 at the 90 deg image
-circle, where the lens compresses the body most, and 0.1 for occluded joints.
+circle, where the lens compresses the body most, and 0.1 for occluded joints. It is the
+visibility score the detector error model (:mod:`render_cams.fisheye.detector`) starts from.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from avatar_models.body import BodyDescription
-from render_cams.device import DeviceError
 from render_cams.fisheye.model import HALF_PI, FisheyeModel
 
 OCCLUDED_CONFIDENCE = 0.1
@@ -87,37 +85,3 @@ def confidence(model: FisheyeModel, uv: np.ndarray, visible: np.ndarray) -> np.n
     theta = np.nan_to_num(model.angle_of_pixels(uv), nan=HALF_PI)
     rim = 1.0 - (1.0 - RIM_CONFIDENCE) * (theta / HALF_PI) ** 2
     return np.where(visible, rim, OCCLUDED_CONFIDENCE)
-
-
-@dataclass(frozen=True)
-class DetectorNoise:
-    """Errors of a 2D pose detector, as assumptions (no published model for fisheye views):
-    Gaussian pixel error, larger for occluded joints (the detector guesses them), and misses.
-
-    Attributes:
-        sigma_px: pixel error of visible joints.
-        occluded_sigma_px: pixel error of occluded joints.
-        miss_rate: probability a visible joint is not reported.
-        occluded_miss_rate: probability an occluded joint is not reported.
-    """
-
-    sigma_px: float = 2.0
-    occluded_sigma_px: float = 12.0
-    miss_rate: float = 0.02
-    occluded_miss_rate: float = 0.5
-
-    def __post_init__(self) -> None:
-        values = (self.sigma_px, self.occluded_sigma_px, self.miss_rate, self.occluded_miss_rate)
-        if not all(np.isfinite(v) and v >= 0 for v in values) or max(values[2:]) > 1:
-            raise DeviceError(f"detector noise needs sigmas >= 0 and rates in [0, 1]: {self}")
-
-    def apply(
-        self, uv: np.ndarray, visible: np.ndarray, conf: np.ndarray, rng: np.random.Generator
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Noisy ``uv`` ``(..., 2)``, ``detected`` mask and confidence (0 where missed)."""
-        sigma = np.where(visible, self.sigma_px, self.occluded_sigma_px)[..., None]
-        noisy = uv + rng.normal(size=uv.shape) * sigma
-        miss = rng.random(visible.shape) < np.where(
-            visible, self.miss_rate, self.occluded_miss_rate
-        )
-        return noisy, ~miss, np.where(miss, 0.0, conf)

@@ -25,6 +25,8 @@ def frame_record(
     lens_blocked: float = 0.0,
     occluded: bool = False,
     mean_luminance: float | None = None,
+    filtered: bool = False,
+    detection: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
 ) -> dict:
     """JSON-ready record of one camera frame.
 
@@ -38,6 +40,9 @@ def frame_record(
             the camera centre is inside the body); occluded: the frame shows (almost) nothing
             but that (:mod:`render_cams.fisheye.occlusion`); mean_luminance: mean grey level
             (0-255) of the image circle as recorded.
+        filtered: the image filter dropped this frame (nothing detected in it).
+        detection: what the 2D detector reported: ``(17, 2)`` pixels, ``(17,)`` bool
+            reported, ``(17,)`` confidence (:mod:`render_cams.fisheye.detector`).
     """
     return {
         "camera": camera,
@@ -55,6 +60,18 @@ def frame_record(
         "in_image": np.asarray(in_image, bool).tolist(),
         "visible": np.asarray(visible, bool).tolist(),
         "confidence": np.round(conf, 4).tolist(),
+        "filtered": bool(filtered),
+        **({} if detection is None else detection_fields(*detection)),
+    }
+
+
+def detection_fields(uv: np.ndarray, detected: np.ndarray, conf: np.ndarray) -> dict:
+    """JSON-ready detector output of one frame: ``detected_px`` ``(17, 2)``, ``detected``
+    ``(17,)`` bool, ``detected_confidence`` ``(17,)``."""
+    return {
+        "detected_px": np.round(uv, 4).tolist(),
+        "detected": np.asarray(detected, bool).tolist(),
+        "detected_confidence": np.round(conf, 4).tolist(),
     }
 
 

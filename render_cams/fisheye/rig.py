@@ -187,3 +187,11 @@ def check_cameras_outside(body: BodyDescription, motion: Motion, poses: np.ndarr
             f"camera {c} is inside the body at frame {t} (centre {poses[t, c, :3, 3].round(3)}); "
             "move its mount outside the hand and arm"
         )
+
+
+def camera_pairs(cameras: Sequence[ControllerCamera]) -> dict[str, list[int]]:
+    """``{controller: [ring, grip]}`` indices of the controllers that carry two cameras."""
+    by_controller: dict[str, list[int]] = {}
+    for c, camera in enumerate(cameras):
+        by_controller.setdefault(camera.controller, []).append(c)
+    return {k: pair for k, pair in by_controller.items() if len(pair) == 2}

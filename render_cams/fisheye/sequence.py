@@ -7,14 +7,19 @@ Layout of ``out_dir``:
 - ``keypoints.json``: the recording's summary (seed, camera model...) and its frame records;
   no timings or absolute paths, so that the same motion and seed give the same bytes in any
   folder;
-- ``stitched/<controller>/NNNNNN.png``: each controller's two cameras on one cylinder;
+- ``stitched/<controller>/NNNNNN.png``: each controller's two cameras on one cylinder, from
+  the frames the image filter kept (a dropped frame leaves its camera's part black, both
+  dropped a black composite);
+- ``torso/<controller>/NNNNNN.png``: the torso-normal view of that composite, where the
+  detector reported both shoulders and hips;
+- ``views.json``: per controller and frame, the detector's keypoints on the composite and in
+  the torso view (:mod:`render_cams.fisheye.pose2d`), with the exact ones;
 - ``fisheye.mp4``: the four cameras tiled 2x2, for a person to watch.
 """
 
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -23,8 +28,9 @@ import imageio.v2 as imageio
 import numpy as np
 
 from render_cams.fisheye.device import FisheyeRecording
-from render_cams.fisheye.model import FisheyeModel
-from render_cams.fisheye.rig import ControllerCamera
+from render_cams.fisheye.pose2d import ControllerPose2D
+from render_cams.fisheye.records import detection_fields
+from render_cams.fisheye.rig import camera_pairs
 from render_cams.fisheye.stitch import stitch_params
 
 
@@ -48,7 +54,8 @@ def write_fisheye_recording(
         "out_dir": str(out),
     }
     if stitch:
-        summary["stitched"] = _write_stitched(recording.model, recording.cameras, images, out)
+        summary["stitched"] = _write_stitched(recording, out)
+        (out / "views.json").write_text(json.dumps(views_json(recording.views)))
     if video:
         n_cams = images.shape[0]
         tiled = np.concatenate(
@@ -65,26 +72,65 @@ def write_fisheye_recording(
     return summary
 
 
-def _write_stitched(
-    model: FisheyeModel,
-    cameras: Sequence[ControllerCamera],
-    images: np.ndarray,
-    out: Path,
-) -> list[str]:
+def _write_stitched(recording: FisheyeRecording, out: Path) -> list[str]:
     """Each controller's two cameras stitched onto one cylinder (ControllerPose §4.2) per
-    frame, from stitch parameters computed once per controller: ``stitched/<controller>/``."""
+    frame from the frames the filter kept, with stitch parameters computed once per
+    controller: ``stitched/<controller>/``; and its torso-normal views: ``torso/<controller>/``."""
     folders = []
-    by_controller: dict[str, list[int]] = {}
-    for c, camera in enumerate(cameras):
-        by_controller.setdefault(camera.controller, []).append(c)
-    for controller, pair in by_controller.items():
-        if len(pair) != 2:
-            continue
-        params = stitch_params(model, [cameras[c] for c in pair])
+    cameras, images = recording.cameras, recording.images
+    for controller, pair in camera_pairs(cameras).items():
+        view = recording.views.get(controller)
+        params = (
+            stitch_params(recording.model, [cameras[c] for c in pair])
+            if view is None
+            else view.params
+        )
         folder = out / "stitched" / controller
         folder.mkdir(parents=True, exist_ok=True)
+        if view is not None:
+            (out / "torso" / controller).mkdir(parents=True, exist_ok=True)
         for t in range(images.shape[1]):
-            composite = params.stitch([images[c, t] for c in pair])
+            usable = ~recording.filtered[pair, t]
+            composite = params.stitch([images[c, t] for c in pair], usable)
             cv2.imwrite(str(folder / f"{t:06d}.png"), composite[..., ::-1])
+            if view is not None and view.torso.valid[t]:
+                warped = cv2.warpPerspective(
+                    composite, view.torso.H[t], (composite.shape[1], composite.shape[0])
+                )
+                cv2.imwrite(str(out / "torso" / controller / f"{t:06d}.png"), warped[..., ::-1])
         folders.append(str(folder.relative_to(out)))
     return folders
+
+
+def views_json(views: dict[str, ControllerPose2D]) -> dict[str, Any]:
+    """JSON-ready composite and torso-view keypoints: ``{controller: [per frame {"composite":
+    {exact_px, in_image, detected_px, detected, detected_confidence}, "torso": {H, ...}}]}``."""
+    out = {}
+    for controller, v in views.items():
+        frames = []
+        for t in range(v.composite.uv.shape[0]):
+            frames.append(
+                {
+                    "composite": {
+                        "exact_px": np.round(np.nan_to_num(v.composite.uv[t]), 4).tolist(),
+                        "in_image": v.composite.in_image[t].tolist(),
+                        **detection_fields(
+                            v.composite_detection.uv[t],
+                            v.composite_detection.detected[t],
+                            v.composite_detection.confidence[t],
+                        ),
+                    },
+                    "torso": {
+                        "valid": bool(v.torso.valid[t]),
+                        "H": np.round(v.torso.H[t], 8).tolist(),
+                        "exact_px": np.round(np.nan_to_num(v.torso_uv[t]), 4).tolist(),
+                        **detection_fields(
+                            v.torso_detection.uv[t],
+                            v.torso_detection.detected[t],
+                            v.torso_detection.confidence[t],
+                        ),
+                    },
+                }
+            )
+        out[controller] = frames
+    return out

@@ -17,6 +17,16 @@ lines in the central plane stay on the centre column. The undistortion to a pinh
 (§4.2's "correct each camera for fisheye distortion") is :func:`undistortion_maps`; the
 cylinder maps go straight from the fisheye, which avoids a pinhole image of a 150 deg lens.
 
+Width: the paper's composite is "roughly 185 deg vertical by 150 deg horizontal" (§4.2): the
+columns span the lenses' full 150 deg horizontal field of view. Along the cylinder's axis
+columns grow as ``tan`` of the angle, so the composite is wide (about 1711 x 741 pixels at the
+paper's 640 x 480): :meth:`StitchParams.coverage` measures what it spans.
+
+Filtering: frames the image filter dropped (:mod:`render_cams.fisheye.bad_frames`, §4.2
+"unusable frames ... that we filter") do not enter the blend: ``stitch(images, usable)``
+renormalises the weights over the usable cameras, so a dropped frame leaves its camera's
+part of the composite black rather than corrupting it.
+
 Parallax: the cameras are 14 cm apart, so one set of maps can only join points at one
 distance exactly. The cylinder has a radius of ``STITCH_DISTANCE_M`` around the midpoint of
 the camera centres: points on that surface land on the same composite pixel from both
@@ -35,7 +45,7 @@ from render_cams.fisheye.model import FisheyeModel
 from render_cams.fisheye.rig import ControllerCamera
 
 STITCH_DISTANCE_M = 0.43  # ControllerPose §3: mean camera-to-body distance
-MAX_HALF_WIDTH_DEG = 65.0  # columns grow as tan(angle): cap the composite's half-width
+MAX_HALF_WIDTH_DEG = 75.0  # half of the composite's 150 deg horizontal field of view (§4.2)
 
 
 def undistortion_maps(
@@ -183,15 +193,45 @@ class StitchParams:
             ]
         )
 
-    def stitch(self, images: Sequence[np.ndarray]) -> np.ndarray:
+    def stitch(self, images: Sequence[np.ndarray], usable: np.ndarray | None = None) -> np.ndarray:
         """``(H, W[, 3])`` the gradient-blended composite of the camera images, in their
-        dtype."""
+        dtype; only the cameras ``usable`` ``(C,)`` bool (default all) contribute, with the
+        blend weights renormalised over them (0 where none of them sees)."""
         warped = self.warp(images).astype(np.float32)
-        w = self.weights if warped.ndim == 3 else self.weights[..., None]
+        weights = self.blend_weights(usable)
+        w = weights if warped.ndim == 3 else weights[..., None]
         out = np.sum(w * warped, axis=0)
         if np.issubdtype(images[0].dtype, np.integer):
             out = np.clip(np.round(out), 0, np.iinfo(images[0].dtype).max)
         return out.astype(images[0].dtype)
+
+    def blend_weights(self, usable: np.ndarray | None = None) -> np.ndarray:
+        """``(C, H, W)`` float32 blend weights of the ``usable`` ``(C,)`` cameras (default
+        all): sum 1 where one of them sees, 0 elsewhere."""
+        if usable is None:
+            return self.weights
+        mask = np.asarray(usable, bool)[:, None, None]
+        kept = np.where(mask & self.valid, np.maximum(self.weights, 1e-6), 0.0)
+        total = kept.sum(axis=0)
+        return np.where(total > 0, kept / np.maximum(total, 1e-12), 0.0).astype(np.float32)
+
+    def coverage(self) -> dict[str, float]:
+        """What the composite spans: ``vertical_deg`` (angle about the axis, down the centre
+        column) and ``horizontal_deg`` (angle along the axis, over all rows), both between the
+        outermost pixels a camera sees, ``seen_fraction`` of all composite pixels, and the
+        composite's ``width`` and ``height``."""
+        cyl = self.cylinder
+        seen = self.valid.any(axis=0)
+        rows = np.flatnonzero(seen[:, int(round(cyl.cu))])
+        cols = np.flatnonzero(seen.any(axis=0))
+        along = np.arctan((cols[[0, -1]] - cyl.cu) / cyl.focal_px)
+        return {
+            "vertical_deg": float(np.degrees((rows[-1] - rows[0] + 1) / cyl.focal_px)),
+            "horizontal_deg": float(np.degrees(along[1] - along[0])),
+            "seen_fraction": float(seen.mean()),
+            "width": cyl.width,
+            "height": cyl.height,
+        }
 
 
 def column_ramp(first: np.ndarray, second: np.ndarray) -> np.ndarray:
@@ -212,16 +252,47 @@ def stitch_params(
     max_half_width_deg: float = MAX_HALF_WIDTH_DEG,
 ) -> StitchParams:
     """The one-time stitch parameters of a controller's two ``cameras`` (the ring and grip
-    cameras of :func:`~render_cams.fisheye.rig.controller_cameras`) with lens ``model``."""
+    cameras of :func:`~render_cams.fisheye.rig.controller_cameras`) with lens ``model``.
+
+    Computed once per lens, mount and cylinder in a process (seconds at 640 x 480: a
+    projection of every composite pixel into both cameras) and shared after: treat the
+    arrays as read-only."""
     if len(cameras) != 2:
         raise ValueError(f"stitching joins two cameras, got {len(cameras)}")
+    key = (
+        model.K.tobytes(),
+        model.D.tobytes(),
+        model.width,
+        model.height,
+        tuple((c.position.tobytes(), c.axes.tobytes()) for c in cameras),
+        float(radius_m),
+        float(max_half_width_deg),
+    )
+    if key not in _STITCH_CACHE:
+        if len(_STITCH_CACHE) >= STITCH_CACHE_SIZE:
+            _STITCH_CACHE.pop(next(iter(_STITCH_CACHE)))  # the oldest
+        _STITCH_CACHE[key] = compute_stitch_params(model, cameras, radius_m, max_half_width_deg)
+    return _STITCH_CACHE[key]
+
+
+STITCH_CACHE_SIZE = 4  # both controllers of two lenses; about 35 MB each at 640 x 480
+_STITCH_CACHE: dict[tuple, StitchParams] = {}
+
+
+def compute_stitch_params(
+    model: FisheyeModel,
+    cameras: Sequence[ControllerCamera],
+    radius_m: float,
+    max_half_width_deg: float,
+) -> StitchParams:
+    """:func:`stitch_params` without the cache."""
     cylinder = stitch_cylinder(model, cameras, radius_m, max_half_width_deg)
     to_cylinder = np.linalg.inv(cylinder.pose)
     poses = np.stack([to_cylinder @ camera_pose(c) for c in cameras])
     v, u = np.mgrid[0 : cylinder.height, 0 : cylinder.width].astype(np.float64)
     surface = cylinder.surface(np.stack([u, v], axis=-1))
     # Surface points in each camera frame: R^T (p - t).
-    in_camera = np.einsum("cba,chwb->chwa", poses[:, :3, :3], surface - poses[:, None, None, :3, 3])
+    in_camera = (surface - poses[:, None, None, :3, 3]) @ poses[:, None, :3, :3]
     uv, valid = model.project(in_camera)
     uv = np.where(valid[..., None], uv, -1.0).astype(np.float32)
     # The camera whose optical axis points further up (-y) takes the top of the overlap.

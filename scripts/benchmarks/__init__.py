@@ -17,6 +17,7 @@ BENCHMARKS: dict[str, str] = {
     "checks": "checks",
     "coolmoves": "coolmoves",
     "cameras": "cameras",
+    "sensing": "sensing",
     "kinect": "kinect",
     "control": "control",
     "suite": "suite",

@@ -9,8 +9,9 @@ whose motion and body every channel shares, and a channel seed.
   but no image is rendered, so ``in_view`` means "in the image and the lens not inside the
   body" and is NOT occlusion-tested (a joint behind the user's own arm counts as in view);
   the rendered visibility of :func:`render_cams.fisheye.keypoints.visibility` needs a range
-  image per frame (images are a later slice). Confidences are
-  :func:`render_cams.fisheye.keypoints.confidence` of that ``in_view``.
+  image per frame (images are a later slice). ``fisheye_uv`` and ``fisheye_conf`` are what
+  a 2D detector reports (:class:`render_cams.fisheye.detector.KeypointDetector`, its default
+  error model, seeded): the exact projections are ``fisheye_uv_projected``.
 - :func:`kinect_channel`: the Kinect skeleton with tracking states (no depth is rendered).
 - :func:`physics_channel`: per-frame foot contact, floor penetration and foot skate from
   :func:`sim.plausibility.check_humanoid`.
@@ -18,12 +19,14 @@ whose motion and body every channel shares, and a channel seed.
 
 from __future__ import annotations
 
+from dataclasses import asdict
 from typing import Any
 
 import numpy as np
 
 from avatar_models.rigs import body17_positions
 from render_cams.device import motion_at_rate
+from render_cams.fisheye.detector import KeypointDetector
 from render_cams.fisheye.device import FisheyeRig
 from render_cams.fisheye.keypoints import confidence, project_joints, world_to_camera
 from render_cams.fisheye.rig import camera_poses, controller_cameras, inside_body
@@ -65,11 +68,13 @@ def vr_channel(humanoid: Humanoid, devices: DeviceSetConfig, seed: int) -> Chann
     return arrays, meta
 
 
-def fisheye_channel(humanoid: Humanoid) -> Channel:
-    """``fisheye_uv`` (Tc, C, 17, 2) pixels, ``fisheye_conf`` (Tc, C, 17), ``fisheye_in_view``
-    (Tc, C, 17) bool, ``fisheye_lens_covered`` (Tc, C) bool, ``fisheye_w2c`` (Tc, C, 4, 4)
-    world-to-camera (OpenCV axes); intrinsics in the JSON. Projected, not rendered, and
-    exact (module docstring): no detector noise yet, so nothing random."""
+def fisheye_channel(humanoid: Humanoid, seed: int) -> Channel:
+    """``fisheye_uv`` (Tc, C, 17, 2) detected pixels ((0, 0) where not detected),
+    ``fisheye_conf`` (Tc, C, 17) detector confidence (0 where not detected),
+    ``fisheye_detected`` (Tc, C, 17) bool, ``fisheye_uv_projected`` (Tc, C, 17, 2) exact
+    pixels, ``fisheye_in_view`` (Tc, C, 17) bool, ``fisheye_lens_covered`` (Tc, C) bool,
+    ``fisheye_w2c`` (Tc, C, 4, 4) world-to-camera (OpenCV axes); intrinsics and the detector
+    model in the JSON. Projected, not rendered (module docstring)."""
     rig = FisheyeRig()
     sampled = motion_at_rate(humanoid.motion, rig.rate_hz)
     cameras = controller_cameras(rig.controllers, rig.mount)
@@ -82,9 +87,14 @@ def fisheye_channel(humanoid: Humanoid) -> Channel:
     )
     uv = uv.reshape(n_frames, n_cams, -1, 2)
     in_view = in_image.reshape(n_frames, n_cams, -1) & ~covered[..., None]
+    detector = KeypointDetector()
+    score = confidence(rig.model, uv, in_view)
+    detection = detector.detect(uv, in_view, in_view, score, np.random.default_rng(seed))
     arrays = {
-        "fisheye_uv": f32(uv),
-        "fisheye_conf": f32(confidence(rig.model, uv, in_view)),
+        "fisheye_uv": f32(detection.uv),
+        "fisheye_conf": f32(detection.confidence),
+        "fisheye_detected": detection.detected,
+        "fisheye_uv_projected": f32(uv),
         "fisheye_in_view": in_view,
         "fisheye_lens_covered": np.ascontiguousarray(covered, dtype=bool),
         "fisheye_w2c": f32(world_to_camera(poses)),
@@ -93,7 +103,10 @@ def fisheye_channel(humanoid: Humanoid) -> Channel:
         "rate_hz": rig.rate_hz,
         "cameras": [c.name for c in cameras],
         "model": rig.model.as_dict(),
-        "keypoints": "projected (in_view not occlusion-tested; no images rendered)",
+        "keypoints": "projected (in_view not occlusion-tested; no images rendered), then "
+        "detected by the detector error model",
+        "detector": asdict(detector),
+        "seed": seed,
     }
     return arrays, meta
 

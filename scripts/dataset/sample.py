@@ -8,7 +8,8 @@ JSON holds the split and group, the subject's parameters, the provenance (source
 window start, every seed, package version, config hash) and each channel's description.
 
 The devices' seed is split with ``SeedSequence`` into one stream per random channel, in a
-fixed order (VR, Kinect), so that adding a channel later leaves the others' draws unchanged.
+fixed order (VR, Kinect, fisheye detector), so that adding a channel later leaves the others'
+draws unchanged.
 """
 
 from __future__ import annotations
@@ -44,10 +45,9 @@ def package_version() -> str:
 
 def channel_seeds(seed: int) -> dict[str, int]:
     """The random channels' seeds from the sample's devices seed (module docstring)."""
-    streams = np.random.SeedSequence(seed).spawn(2)
-    return {
-        name: int(s.generate_state(1)[0]) for name, s in zip(("vr", "kinect"), streams, strict=True)
-    }
+    names = ("vr", "kinect", "fisheye")
+    streams = np.random.SeedSequence(seed).spawn(len(names))
+    return {name: int(s.generate_state(1)[0]) for name, s in zip(names, streams, strict=True)}
 
 
 def make_sample(
@@ -68,7 +68,7 @@ def make_sample(
         arrays_vr, channels["vr"] = vr_channel(humanoid, devices, seeds["vr"])
         arrays |= arrays_vr
     if devices.fisheye:
-        arrays_fisheye, channels["fisheye"] = fisheye_channel(humanoid)
+        arrays_fisheye, channels["fisheye"] = fisheye_channel(humanoid, seeds["fisheye"])
         arrays |= arrays_fisheye
     if devices.kinect != "none":
         arrays_kinect, channels["kinect"] = kinect_channel(

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from avatar_models.generator import generate
+from render_cams.device import DeviceError
 from render_cams.fisheye import bad_frames
 from render_cams.fisheye.model import FisheyeModel
 from render_cams.fisheye.render import FisheyeRenderer
@@ -41,3 +42,22 @@ def test_detector_precision_and_recall(frames):
     assert scores["injected"] > 20
     assert scores["precision"] >= 0.9 and scores["recall"] >= 0.9
     assert not bad_frames.detect(frames).any()
+
+
+def test_defects_the_filter_was_not_designed_around(frames):
+    # Measured by ``avatarsim bench sensing``; here only that each defect is what it says.
+    rng = np.random.default_rng(0)
+    for kind in bad_frames.UNSEEN_KINDS:
+        corrupted, flags, kinds = bad_frames.inject(frames, rng, rate=1.0, kinds=(kind,))
+        assert flags.all() and set(kinds) == {kind}
+        before, after = frames.astype(float), corrupted.astype(float)
+        if kind == "motion_blur":  # smoother: less energy between neighbouring pixels
+            assert np.abs(np.diff(after, axis=2)).mean() < np.abs(np.diff(before, axis=2)).mean()
+        elif kind == "hand_in_view":  # a large part of every frame replaced
+            changed = np.any(np.abs(after - before) > 20, axis=-1).mean(axis=(1, 2))
+            assert np.all(changed > 0.2)
+        else:  # brighter, more of it clipped white
+            assert after.mean() > before.mean() + 30
+            assert (corrupted == 255).mean() > (frames == 255).mean() + 0.2
+    with pytest.raises(DeviceError, match="unknown bad-frame kinds"):
+        bad_frames.inject(frames, rng, kinds=("smudge",))

@@ -24,6 +24,13 @@ def test_sequence_files_and_records_reproject_with_opencv(tmp_path):
     assert summary["stitched"] == ["stitched/left_controller", "stitched/right_controller"]
     composites = sorted((tmp_path / "stitched" / "left_controller").glob("*.png"))
     assert len(composites) == 10 and cv2.imread(str(composites[0])).mean() > 0
+    # The detector's keypoints on each composite and its torso-normal view, every frame.
+    views = json.loads((tmp_path / "views.json").read_text())
+    assert sorted(views) == ["left_controller", "right_controller"]
+    frame = views["left_controller"][3]
+    assert len(frame["composite"]["detected_px"]) == 17 and len(frame["torso"]["H"]) == 3
+    torso_files = len(list((tmp_path / "torso" / "left_controller").glob("*.png")))
+    assert torso_files == sum(f["torso"]["valid"] for f in views["left_controller"])
     data = json.loads((tmp_path / "keypoints.json").read_text())
     assert data["seed"] == 5 and len(data["records"]) == 40
     record = data["records"][7]

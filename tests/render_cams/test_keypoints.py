@@ -7,7 +7,6 @@ from avatar_models.body17 import INDEX
 from avatar_models.generator import generate
 from avatar_models.rigs import body17_positions
 from render_cams.fisheye.keypoints import (
-    DetectorNoise,
     confidence,
     joint_thickness,
     project_joints,
@@ -68,17 +67,6 @@ def test_hand_between_camera_and_knee_occludes_the_knee(setup):
     assert before[knee_i] and not after[knee_i]
     conf = confidence(model, uv[0], after)
     assert conf[knee_i] == pytest.approx(0.1) and conf[before & after].min() >= 0.5
-
-
-def test_detector_noise_statistics():
-    uv = np.zeros((20000, 2))
-    visible = np.arange(20000) % 2 == 0
-    noise = DetectorNoise(sigma_px=2.0, occluded_sigma_px=10.0, miss_rate=0.1)
-    noisy, detected, conf = noise.apply(uv, visible, np.ones(20000), np.random.default_rng(0))
-    assert noisy[visible].std() == pytest.approx(2.0, rel=0.05)
-    assert noisy[~visible].std() == pytest.approx(10.0, rel=0.05)
-    assert 1 - detected[visible].mean() == pytest.approx(0.1, abs=0.01)
-    assert np.all(conf[~detected] == 0)
 
 
 def test_rig_cameras_ride_on_the_controllers_and_look_at_the_body(setup):

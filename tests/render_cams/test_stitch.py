@@ -1,18 +1,15 @@
-"""Undistortion, cylindrical stitching of a controller's two cameras and torso-normal-aligned
-views (ControllerPose §4.2-4.3), checked against projection geometry and OpenCV."""
+"""Undistortion and cylindrical stitching of a controller's two cameras (ControllerPose §4.2),
+checked against projection geometry and OpenCV."""
 
 from __future__ import annotations
 
 import cv2
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation
 
-from avatar_models.body17 import BODY17, INDEX
 from render_cams.fisheye.model import FisheyeModel
 from render_cams.fisheye.rig import COMPOSITE_VERTICAL_FOV_DEG, controller_cameras
 from render_cams.fisheye.stitch import stitch_params, undistortion_maps
-from render_cams.fisheye.torso_view import TorsoViewError, pinhole, torso_view
 
 MODEL = FisheyeModel.from_fov(D=(0.02, -0.01, 0.003, -0.0005))
 
@@ -144,67 +141,18 @@ def test_stitched_frame_is_the_weighted_sum(params):
     assert np.max(np.abs(out[..., 1].astype(float) - expected)) <= 0.5 + 1e-3
 
 
-# -- torso-normal-aligned views -------------------------------------------------------------
-K = np.array([[300.0, 0, 320.0], [0, 300.0, 240.0], [0, 0, 1]])
+def test_composite_is_185_by_150_degrees(params):
+    # ControllerPose §4.2: "roughly 185 deg vertical by 150 deg horizontal"; the composite's
+    # angles are measured from its pixels' rays, not from the constants that built it.
+    coverage = params.coverage()
+    assert coverage["horizontal_deg"] == pytest.approx(150.0, abs=1.0)
+    assert coverage["vertical_deg"] == pytest.approx(COMPOSITE_VERTICAL_FOV_DEG, abs=4.0)
 
 
-def torso_joints(rotation: np.ndarray, centre, width=0.36, height=0.5) -> np.ndarray:
-    """``(17, 3)`` camera-frame body17 joints of a planar rectangular torso facing the camera
-    (chest towards -z, up -y) turned by ``rotation`` about its centre; limbs at the centre."""
-    local = {
-        "l_shoulder": [width / 2, -height / 2, 0],
-        "r_shoulder": [-width / 2, -height / 2, 0],
-        "l_hip": [width / 2, height / 2, 0],
-        "r_hip": [-width / 2, height / 2, 0],
-        "neck": [0, -height / 2, 0],
-        "pelvis": [0, height / 2, 0],
-        "head": [0, -height / 2 - 0.2, -0.05],
-    }
-    joints = np.zeros((len(BODY17), 3))
-    for name, p in local.items():
-        joints[INDEX[name]] = p
-    return joints @ rotation.T + np.asarray(centre, float)
-
-
-def test_fronto_parallel_torso_gives_identity():
-    view = torso_view(K, torso_joints(np.eye(3), [0.3, -0.1, 1.5]))
-    assert np.allclose(view.H / view.H[2, 2], np.eye(3), atol=1e-6)
-
-
-def test_oblique_torso_is_rectified_to_its_true_shape():
-    rotation = Rotation.from_euler("yx", [40.0, -25.0], degrees=True).as_matrix()
-    joints = torso_joints(rotation, [0.2, 0.15, 1.2])
-    view = torso_view(K, joints)
-    mapped = cv2.perspectiveTransform(view.src.reshape(-1, 1, 2), view.H).reshape(-1, 2)
-    assert np.max(np.abs(mapped - view.dst)) < 1e-3  # the four points, exactly
-    # In the view the torso is fronto-parallel: a rectangle with the true aspect ratio.
-    ls, rs, rh, lh = view.dst
-    top, side = rs - ls, rh - rs
-    assert (
-        abs(np.degrees(np.arccos(top @ side / np.linalg.norm(top) / np.linalg.norm(side))) - 90)
-        < 0.05
-    )
-    assert np.linalg.norm(top) / np.linalg.norm(side) == pytest.approx(0.36 / 0.5, rel=1e-4)
-    assert np.linalg.norm(lh - ls) == pytest.approx(np.linalg.norm(side), rel=1e-4)
-    # Every other point, on the torso plane or off it (head), moves as the turned camera sees it.
-    shift = view.dst.mean(0) - pinhole(K, joints[[3, 6, 13, 9]] @ view.rotation).mean(0)
-    for name in ("neck", "head"):
-        src = pinhole(K, joints[INDEX[name]])
-        expected = pinhole(K, joints[INDEX[name]] @ view.rotation) + shift
-        got = cv2.perspectiveTransform(src.reshape(1, 1, 2), view.H).reshape(2)
-        assert np.linalg.norm(got - expected) < 0.01
-
-
-def test_warped_view_moves_image_content_with_the_transform():
-    rotation = Rotation.from_euler("y", 35.0, degrees=True).as_matrix()
-    view = torso_view(K, torso_joints(rotation, [0.0, 0.0, 1.3]))
-    image = np.zeros((480, 640), np.float32)
-    src = np.round(view.src[0]).astype(int)
-    image[src[1] - 2 : src[1] + 3, src[0] - 2 : src[0] + 3] = 1.0
-    expected = cv2.perspectiveTransform(src.reshape(1, 1, 2).astype(float), view.H).reshape(2)
-    assert np.linalg.norm(centroid(view.warp(image)) - expected) < 0.5
-
-
-def test_torso_behind_the_camera_is_an_error():
-    with pytest.raises(TorsoViewError):
-        torso_view(K, torso_joints(np.eye(3), [0.0, 0.0, -1.0]))
+def test_a_filtered_camera_leaves_the_blend(params):
+    ring = np.full((480, 640, 3), 80, np.uint8)
+    grip = np.full((480, 640, 3), 200, np.uint8)
+    out = params.stitch([ring, grip], usable=np.array([False, True]))
+    assert np.all(out[params.valid[1]] == 200)  # the grip camera alone, at full weight
+    assert np.all(out[~params.valid[1]] == 0)  # nothing where only the dropped camera sees
+    assert np.all(params.stitch([ring, grip], usable=np.array([False, False])) == 0)

@@ -30,11 +30,18 @@ def test_ground_truth_and_devices_agree(first_sample):
     hmd = meta["channels"]["vr"]["devices"].index("hmd")
     gap = np.linalg.norm(arrays["vr_pos"][::3, hmd] - head, axis=-1)
     assert np.median(gap) < 0.2
-    # four controller cameras at 30 Hz, keypoints with confidences in (0, 1]
+    # four controller cameras at 30 Hz; a detector's keypoints: confidences in (0, 1] where
+    # detected, 0 elsewhere, only joints in view detected (a left/right swap may report a
+    # limb on the side not in view), near but not at the projections
     uv, conf, seen = arrays["fisheye_uv"], arrays["fisheye_conf"], arrays["fisheye_in_view"]
-    assert uv.shape == (t, 4, 17, 2) and conf.shape == seen.shape == (t, 4, 17)
-    assert seen.any() and np.all((conf > 0) & (conf <= 1))
-    assert np.all(np.isfinite(uv[seen]))
+    found, exact = arrays["fisheye_detected"], arrays["fisheye_uv_projected"]
+    assert uv.shape == exact.shape == (t, 4, 17, 2) and conf.shape == seen.shape == (t, 4, 17)
+    middle = [INDEX[j] for j in ("head", "neck", "pelvis")]
+    assert found.any() and not np.any(found[..., middle] & ~seen[..., middle])
+    assert np.all((conf[found] > 0) & (conf[found] <= 1)) and np.all(conf[~found] == 0)
+    assert np.all(np.isfinite(uv)) and np.all(np.isfinite(exact[seen]))
+    error = np.linalg.norm(uv - exact, axis=-1)[found]
+    assert 0 < np.median(error) < 50  # pixels in a 640 x 480 image
     assert "projected" in meta["channels"]["fisheye"]["keypoints"]
     # Kinect V2: 25 joints, tracking states 0..2
     assert arrays["kinect_pos"].shape == (t, 25, 3)

@@ -1,0 +1,95 @@
+"""The 2D keypoint detector's error model: its statistics are the configured ones, and its
+confidences fall as its errors grow."""
+
+import numpy as np
+import pytest
+from scipy.stats import spearmanr
+
+from avatar_models.body17 import BODY17, INDEX
+from render_cams.device import DeviceError
+from render_cams.fisheye.detector import BODY17_SIGMAS, KeypointDetector
+
+N = 20000
+# A person whose keypoints span a 200 x 400 px box: person size sqrt(200 * 400) px.
+BOX = np.array([[100.0, 50.0], [300.0, 450.0]])
+SCALE_PX = np.sqrt(200.0 * 400.0)
+
+
+def person(n: int = N) -> np.ndarray:
+    """``(n, 17, 2)`` keypoints spread over BOX, corners included."""
+    rng = np.random.default_rng(123)
+    uv = BOX[0] + rng.random((17, 2)) * (BOX[1] - BOX[0])
+    uv[0], uv[1] = BOX[0], BOX[1]
+    return np.broadcast_to(uv, (n, 17, 2)).copy()
+
+
+def run(detector, visible=True, score=1.0, seed=0, n=N):
+    uv = person(n)
+    shape = uv.shape[:2]
+    return uv, detector.detect(
+        uv,
+        np.ones(shape, bool),
+        np.broadcast_to(visible, shape),
+        np.broadcast_to(score, shape),
+        np.random.default_rng(seed),
+    )
+
+
+def test_localisation_error_is_the_coco_sigma_times_the_person_size():
+    detector = KeypointDetector(error_scale=1.5, occluded_scale=3.0, miss_rate=0.0, swap_rate=0.0)
+    visible = np.arange(17) % 2 == 0
+    uv, detection = run(detector, visible=visible)
+    np.testing.assert_allclose(detection.scale_px, SCALE_PX)
+    per_axis = (detection.uv - uv).std(axis=0).mean(axis=-1)  # (17,)
+    # COCO OKS sigmas, written out independently: shoulders .079, hips .107, nose .026 ...
+    assert BODY17_SIGMAS[INDEX["l_shoulder"]] == 0.079 and BODY17_SIGMAS[INDEX["r_hip"]] == 0.107
+    expected = 1.5 * BODY17_SIGMAS * SCALE_PX * np.where(visible, 1.0, 3.0)
+    np.testing.assert_allclose(per_axis, expected, rtol=0.03)  # 20000 draws: ~0.5 % s.e.
+
+
+def test_missed_joints_follow_visibility_and_swaps_their_rate():
+    detector = KeypointDetector(miss_rate=0.6, swap_rate=0.1)
+    for score in (1.0, 0.5, 0.1):
+        _, detection = run(detector, score=score)
+        missed = 1.0 - detection.detected.mean()
+        assert missed == pytest.approx(0.6 * (1.0 - score), abs=0.01)
+    uv, detection = run(KeypointDetector(error_scale=0.0, miss_rate=0.0, swap_rate=0.1))
+    assert detection.swapped.mean(axis=0) == pytest.approx([0.1, 0.1], abs=0.01)
+    arms, legs = detection.swapped[:, 0], detection.swapped[:, 1]
+    l_wrist, r_wrist, l_foot = INDEX["l_wrist"], INDEX["r_wrist"], INDEX["l_foot"]
+    np.testing.assert_allclose(detection.uv[arms, l_wrist], uv[arms, r_wrist])
+    np.testing.assert_allclose(detection.uv[~arms, l_wrist], uv[~arms, l_wrist])
+    np.testing.assert_allclose(detection.uv[legs, l_foot], uv[legs, INDEX["r_foot"]])
+
+
+def test_confidence_falls_as_the_error_grows():
+    detector = KeypointDetector(swap_rate=0.0, miss_rate=0.0)
+    for seed in (0, 1, 2):
+        uv, detection = run(detector, seed=seed, n=2000)
+        error = np.linalg.norm(detection.uv - uv, axis=-1) / (BODY17_SIGMAS * SCALE_PX)
+        rho = spearmanr(error.ravel(), detection.confidence.ravel()).statistic
+        # Measured -0.872 on seeds 0-2 (confidence noise 0.2); a detector whose confidence
+        # ignored the error would give 0.
+        assert rho < -0.75
+    # Lower visibility scales confidence down.
+    _, dim = run(detector, score=0.5, n=2000)
+    assert dim.confidence.mean() == pytest.approx(0.5 * detection.confidence.mean(), rel=0.05)
+
+
+def test_no_person_below_four_joints_and_nothing_out_of_the_image():
+    uv = person(10)
+    in_image = np.zeros((10, 17), bool)
+    in_image[:, :3] = True
+    in_image[5:, 3:6] = True
+    detection = KeypointDetector().detect(
+        uv, in_image, np.ones((10, 17), bool), np.ones((10, 17)), np.random.default_rng(0)
+    )
+    assert not detection.detected[:5].any() and np.all(detection.uv[:5] == 0)
+    assert not detection.detected[:, 6:].any() and np.all(detection.confidence[:, 6:] == 0)
+    assert len(BODY17) == detection.detected.shape[1]
+
+
+@pytest.mark.parametrize("bad", [{"miss_rate": 1.5}, {"error_scale": -1.0}, {"swap_rate": np.nan}])
+def test_bad_parameters_are_rejected(bad):
+    with pytest.raises(DeviceError, match="detector model"):
+        KeypointDetector(**bad)
