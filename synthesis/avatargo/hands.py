@@ -111,9 +111,7 @@ def grip_of(skeleton: Skeleton) -> Grip:
     return Grip(np.stack(centres), np.stack(handles))
 
 
-def palm_offsets(
-    controller_rot0: np.ndarray, wrist_rot0: np.ndarray, grip: Grip
-) -> TrackerOffsets:
+def palm_offsets(controller_rot0: np.ndarray, wrist_rot0: np.ndarray, grip: Grip) -> TrackerOffsets:
     """The wrists in their controllers' frames: eq. 3 for the rotation (``R0(C)^-1
     R0(wrist)``) and the exact palm-to-wrist offset for the position, from the walk-in
     controller rotations ``(2, 4)`` and the avatar's wrist rotations ``(2, 4)``."""

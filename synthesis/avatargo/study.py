@@ -41,8 +41,9 @@ STRAP_MAX_M = 0.05
 TRACKERS = ("left_foot_tracker", "right_foot_tracker", "back_tracker")
 WALK_IN_S = 0.5
 """How long the user stands in the T-pose before the trigger (the sample is the last one)."""
-STANDING_KNEE_DEG = 15.0
-"""The user stands where both knees are flexed less than this (our choice)."""
+STANDING_KNEE_DEG = 30.0
+"""The user stands where both knees are flexed less than this from the rest pose (our
+choice: the generator's idle stance keeps soft knees at 23 deg)."""
 EFFECTORS = {"head": "head", "l_foot": "l_ankle", "r_foot": "r_ankle", "root": "pelvis"}
 """Scored end effectors: report name -> body17 joint."""
 
@@ -114,17 +115,26 @@ def walk_in(setup: VRSetup, skeleton: Skeleton, user: SimulatedUser) -> Tracking
     return TrackingFrame.from_stream(stream, stream.n_samples - 1)
 
 
-def knee_flexion(positions: np.ndarray, rig_body17: dict, skeleton: Skeleton) -> np.ndarray:
-    """``(T, 2)`` knee flexion (radians, 0 straight) of joint positions ``(T, J, 3)``."""
+def knee_angle(positions: np.ndarray, skeleton: Skeleton) -> np.ndarray:
+    """``(..., 2)`` angle (radians) between thigh and shank of joint positions ``(..., J, 3)``
+    of ``skeleton``, left and right."""
+    body17 = identify_rig(skeleton).body17
     out = []
     for s in "lr":
         hip, knee, ankle = (
-            positions[:, skeleton.index(rig_body17[f"{s}_{j}"])] for j in ("hip", "knee", "ankle")
+            positions[..., skeleton.index(body17[f"{s}_{j}"]), :] for j in ("hip", "knee", "ankle")
         )
         thigh, shank = knee - hip, ankle - knee
-        cos = (thigh * shank).sum(-1) / np.linalg.norm(thigh, axis=-1) / np.linalg.norm(shank, axis=-1)
-        out.append(np.arccos(np.clip(cos, -1.0, 1.0)))
-    return np.stack(out, axis=1)
+        norms = np.linalg.norm(thigh, axis=-1) * np.linalg.norm(shank, axis=-1)
+        out.append(np.arccos(np.clip((thigh * shank).sum(-1) / norms, -1.0, 1.0)))
+    return np.stack(out, axis=-1)
+
+
+def knee_flexion(motion: Motion) -> np.ndarray:
+    """``(T, 2)`` knee flexion (radians) from the rig's rest pose (0: as straight as at rest;
+    rest knees of the avatar rig sit ~23 deg off the hip-ankle line)."""
+    rest = knee_angle(motion.skeleton.rest_positions(), motion.skeleton)
+    return knee_angle(motion.global_positions(), motion.skeleton) - rest
 
 
 def reference(truth: Motion, user: SimulatedUser, synth: AvatarGo) -> np.ndarray:
@@ -145,13 +155,12 @@ def score(truth: Motion, output: Motion, user: SimulatedUser, synth: AvatarGo) -
     """The study's measures for one run (cm, degrees, shares)."""
     n = min(truth.n_frames, output.n_frames)
     truth, output = truth[:n], output[:n]
-    rig, arig = identify_rig(truth.skeleton), synth.body.rig
+    arig = synth.body.rig
     out_pos = output.global_positions()
     got = out_pos[:, output.skeleton.indices([arig.body17[j] for j in EFFECTORS.values()])]
     err = np.linalg.norm(got - reference(truth, user, synth), axis=-1)  # (T, 4)
-    user_knee = knee_flexion(truth.global_positions(), rig.body17, truth.skeleton)
-    avatar_knee = knee_flexion(out_pos, arig.body17, output.skeleton)
-    standing = (user_knee < np.radians(STANDING_KNEE_DEG)).all(1)
+    user_knee, avatar_knee = knee_flexion(truth), knee_flexion(output)
+    standing = (np.abs(user_knee) < np.radians(STANDING_KNEE_DEG)).all(1)
     knee_err = np.abs(avatar_knee - user_knee)[standing]
     palm = np.array(synth.palm_distance[-n:]) if synth.palm_distance else np.zeros((0, 2))
     result = {
@@ -188,4 +197,3 @@ def study_run(
         out[kind] = score(truth, motion, user, synth)
         out["motions"][kind] = motion
     return out
-

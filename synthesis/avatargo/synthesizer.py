@@ -70,6 +70,8 @@ rotations (eq. 3); the spine's bend is a soft hint; the wrists sit between them,
 controller out of reach does not drag the body (our choice; mink weighs 1 rad like 1 m)."""
 ITERATIONS_PER_TICK = 2
 """QP iterations per 90 Hz tick after the first (warm start; the goals move < 2 cm a tick)."""
+FIRST_ITERATIONS = 40
+"""QP iterations of the first tick, from the T-pose rigidly fitted to the goals."""
 OFFSET_KINDS = ("exact", "fixed")
 
 
@@ -269,9 +271,11 @@ class AvatarGo(Synthesizer):
         hand = [FULL_BODY.index(d) for d in HANDS]
         for b in range(frames.size):
             if seen[b]:
-                steps = self.iterations_per_tick * (1 if self._solved else 4)
+                start, steps = self._q, self.iterations_per_tick
+                if not self._solved:  # the first goals may be far from the walk-in T-pose
+                    start, steps = self.ik.fitted_root(goal_pos[b]), FIRST_ITERATIONS
                 self._solved = True
-                self._q, _, _ = self.ik.solve_frame(goal_pos[b], self._q, goal_rot[b], steps)
+                self._q, _, _ = self.ik.solve_frame(goal_pos[b], start, goal_rot[b], steps)
                 wrist = data.site_xpos[self._wrist_sites]
                 wrist_rot = quat.from_matrix(data.site_xmat[self._wrist_sites].reshape(2, 3, 3))
                 self.palm_distance.append(palm_distance(wrist, wrist_rot, pos[b, hand], self.grip))
