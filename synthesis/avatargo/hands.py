@@ -1,7 +1,9 @@
 """Hands on the controllers (AvatarGo §3.4 "Hands"): the palm over the controller's centre.
 
-The wrist is placed so that the controller's centre always sits under the palm, at an exact
-palm-to-wrist offset: with ``c`` the controller centre in the wrist frame (:class:`Grip`),
+The wrist is placed so that the controller always sits under the palm, at an exact
+palm-to-wrist offset: with ``c`` the palm point in the wrist frame where the controller's
+tracked centre is held (:class:`Grip`; the simulated devices' convention,
+:func:`render_cams.vr.nominal_attachment`: in the palm, along the rest forearm),
 ``R_t(wrist) = R_t(C) R0(C)^-1 R0(wrist)`` (eq. 3 with the controller as tracker) and
 ``p_t(wrist) = p_t(C) - R_t(wrist) c``, i.e. a :class:`~synthesis.avatargo.offsets.
 TrackerOffsets` (:func:`palm_offsets`). Where the avatar's arm is too short to put the wrist
@@ -10,9 +12,9 @@ to the hand instead of the physical one (§3.4): :func:`palm_distance` measures 
 palm's controller point ended from the tracked controller, and a frame counts as unreached
 beyond :data:`REACH_TOLERANCE_M`.
 
-The controller is a capsule (its handle): :data:`CONTROLLER_RADIUS_M`,
-:data:`HANDLE_LENGTH_M`, lying across the palm (along the knuckle line) under the palm
-centre; the finger IK (:mod:`synthesis.avatargo.fingers`) closes the fingers on it.
+The controller's body is a capsule (its handle): :data:`CONTROLLER_RADIUS_M`,
+:data:`HANDLE_LENGTH_M`, lying across the palm (along the knuckle line) right under the palm
+point; the finger IK (:mod:`synthesis.avatargo.fingers`) closes the fingers on it.
 """
 
 from __future__ import annotations
@@ -23,7 +25,7 @@ import numpy as np
 
 from avatar_models import Skeleton, quat
 from avatar_models.rigs import identify_rig
-from render_cams.vr.placements import GRIP_DISTANCE_M
+from render_cams.vr import nominal_attachment
 from synthesis.avatargo.offsets import TrackerOffsets
 
 CONTROLLER_RADIUS_M = 0.02
@@ -35,9 +37,6 @@ PALM_HALF_THICKNESS_M = 0.012
 deeper where a rest finger bone (the thumb's) lies further below, plus
 :data:`FINGER_CLEARANCE_M`: the open hand must not start inside the handle."""
 FINGER_CLEARANCE_M = 0.001
-PALM_FRACTION = 0.6
-"""The palm centre lies this far from the wrist towards the knuckles (our choice: the
-middle of the metacarpals, slightly towards the knuckles where a power grip holds)."""
 REACH_TOLERANCE_M = 0.02
 """A controller further than this from the palm point counts as unreached (our choice:
 well above the IK's residual on reachable targets, ~1 mm)."""
@@ -68,47 +67,43 @@ class Grip:
     """Where each hand holds its controller, in the wrist frames (left, right).
 
     Attributes:
-        centre: ``(2, 3)`` the controller centre under the palm.
-        handle: ``(2, 2, 3)`` the capsule's end points ``s, e`` (eq. 5).
+        palm: ``(2, 3)`` the palm point that holds the controller's tracked centre.
+        handle: ``(2, 2, 3)`` the capsule's end points ``s, e`` (eq. 5), under the palm.
     """
 
-    centre: np.ndarray
+    palm: np.ndarray
     handle: np.ndarray
 
 
 def grip_of(skeleton: Skeleton) -> Grip:
     """The controllers under the palms of ``skeleton`` (its rest pose, hand frames).
 
-    With the avatar rig's finger bones the palm centre is :data:`PALM_FRACTION` of the way
-    from the wrist to the middle of the knuckles and the handle lies along the knuckle line;
-    the handle's top is below every rest finger bone. On a rig without fingers the palm is
-    :data:`~render_cams.vr.placements.GRIP_DISTANCE_M` along the rest forearm and the
-    handle lies forward (+X) across it.
+    The palm point is the controllers' nominal grip on the rig
+    (:func:`~render_cams.vr.nominal_attachment`). With the avatar rig's finger bones the
+    handle lies along the knuckle line, its top below every rest finger bone; on a rig
+    without fingers it lies forward (+X).
     """
     rig = identify_rig(skeleton)
     rest = skeleton.rest_positions()
-    centres, handles = [], []
-    for side, s in (("L", "l"), ("R", "r")):
-        wrist = rest[skeleton.index(rig.body17[f"{s}_wrist"])]
+    palms, handles = [], []
+    for side, device in (("L", "left_controller"), ("R", "right_controller")):
+        palm = nominal_attachment(device, skeleton).position
+        wrist = rest[skeleton.index(rig.body17[f"{side.lower()}_wrist"])]
         if has_fingers(skeleton):
-            knuckles = rest[skeleton.indices([finger_joint(side, f) for f in (1, 2, 3, 4)])]
-            palm = PALM_FRACTION * (knuckles.mean(0) - wrist)
             ends = rest[skeleton.indices([finger_joint(side, int(k[-1])) for k in KNUCKLES])]
             across = ends[0] - ends[1]
             bones = [finger_joint(side, f, g) for f in range(5) for g in ("", "1", "2", "Nub")]
             depth = ((rest[skeleton.indices(bones)] - wrist) @ PALM_NORMAL).max()
             skin = max(PALM_HALF_THICKNESS_M, depth + FINGER_CLEARANCE_M)
         else:
-            elbow = rest[skeleton.index(rig.body17[f"{s}_elbow"])]
-            palm = GRIP_DISTANCE_M * (wrist - elbow) / np.linalg.norm(wrist - elbow)
             across = np.array([1.0, 0.0, 0.0])
             skin = PALM_HALF_THICKNESS_M
         across = across - (across @ PALM_NORMAL) * PALM_NORMAL
         across /= np.linalg.norm(across)
         centre = palm + (CONTROLLER_RADIUS_M + skin) * PALM_NORMAL
-        centres.append(centre)
+        palms.append(palm)
         handles.append(centre + 0.5 * HANDLE_LENGTH_M * np.stack([-across, across]))
-    return Grip(np.stack(centres), np.stack(handles))
+    return Grip(np.stack(palms), np.stack(handles))
 
 
 def palm_offsets(controller_rot0: np.ndarray, wrist_rot0: np.ndarray, grip: Grip) -> TrackerOffsets:
@@ -116,7 +111,7 @@ def palm_offsets(controller_rot0: np.ndarray, wrist_rot0: np.ndarray, grip: Grip
     R0(wrist)``) and the exact palm-to-wrist offset for the position, from the walk-in
     controller rotations ``(2, 4)`` and the avatar's wrist rotations ``(2, 4)``."""
     rotation = quat.mul(quat.conj(quat.normalize(controller_rot0)), wrist_rot0)
-    return TrackerOffsets(-quat.rotate(rotation, grip.centre), rotation)
+    return TrackerOffsets(-quat.rotate(rotation, grip.palm), rotation)
 
 
 def palm_distance(
@@ -125,5 +120,5 @@ def palm_distance(
     """``(B, 2)`` metres from the palm's controller point of the solved wrists
     (``wrist_pos (B, 2, 3)``, ``wrist_rot (B, 2, 4)``) to the tracked controllers
     ``(B, 2, 3)``; beyond :data:`REACH_TOLERANCE_M` the virtual controller is on the hand."""
-    held = wrist_pos + quat.rotate(wrist_rot, grip.centre)
+    held = wrist_pos + quat.rotate(wrist_rot, grip.palm)
     return np.linalg.norm(held - controller_pos, axis=-1)

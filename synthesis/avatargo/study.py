@@ -33,6 +33,7 @@ from render_cams.vr import FULL_BODY, Attachment, NoiseModel, VRSetup, nominal_a
 from synthesis.avatargo.hands import REACH_TOLERANCE_M
 from synthesis.avatargo.synthesizer import AvatarGo
 from synthesis.base import TrackingFrame
+from synthesis.ik_baseline import rest_body_frame, stands_upright
 
 LIMB_SPREAD = 0.10
 """Avatar leg and arm lengths over the user's: uniform in ``1 +- LIMB_SPREAD`` (issue 13)."""
@@ -96,11 +97,22 @@ def avatar_of(skeleton: Skeleton, user: SimulatedUser) -> Skeleton:
 
 def t_pose(skeleton: Skeleton, heading_rad: float, seconds: float = WALK_IN_S) -> Motion:
     """``skeleton`` standing still in its rest T-pose at the origin, feet on the floor,
-    turned to ``heading_rad``, for ``seconds`` at 90 Hz."""
+    turned to ``heading_rad``, for ``seconds`` at 90 Hz.
+
+    A rig whose rest pose does not stand facing +X (Bandai's lies along +Y) is first turned
+    upright (:func:`~synthesis.ik_baseline.rest_body_frame`) with its lowest joint on the
+    floor; an upright rig stands on its body's feet (:func:`build_body`'s root height, as
+    the avatar's in :class:`~synthesis.avatargo.synthesizer.AvatarGo`)."""
     frames = int(round(seconds * 90.0)) + 1
+    heading = quat.from_axis_angle(np.array([0.0, 0.0, 1.0]), np.array(heading_rad))
+    if stands_upright(skeleton):
+        stand, height = quat.IDENTITY, build_body(skeleton).root_height
+    else:
+        stand = quat.from_matrix(rest_body_frame(skeleton).T)
+        height = -quat.rotate(stand, skeleton.rest_positions())[:, 2].min()
     local = np.tile(quat.IDENTITY, (frames, skeleton.n_joints, 1))
-    local[:, 0] = quat.from_axis_angle(np.array([0.0, 0.0, 1.0]), np.array(heading_rad))
-    root = np.tile([0.0, 0.0, build_body(skeleton).root_height], (frames, 1))
+    local[:, 0] = quat.mul(heading, stand)
+    root = np.tile([0.0, 0.0, height], (frames, 1))
     return Motion(skeleton, 90.0, root, local)
 
 
@@ -109,9 +121,13 @@ def setup_for(user: SimulatedUser, noise: tuple[NoiseModel, ...] = ()) -> VRSetu
     return VRSetup(devices=FULL_BODY, noise=noise, offsets=user.straps)
 
 
-def walk_in(setup: VRSetup, skeleton: Skeleton, user: SimulatedUser) -> TrackingFrame:
-    """The devices' last sample while the user stands in the T-pose (the trigger press)."""
-    stream = setup.sample(t_pose(skeleton, user.heading_rad), seed=user.seed)
+def walk_in(
+    setup: VRSetup, skeleton: Skeleton, seed: int, heading_rad: float = 0.0
+) -> TrackingFrame:
+    """The devices' last sample while a user of ``skeleton`` stands in the T-pose facing
+    ``heading_rad`` (the trigger press), sampled by ``setup`` with ``seed`` (the seed of the
+    session's stream, so that the devices sit where they sit during the session)."""
+    stream = setup.sample(t_pose(skeleton, heading_rad), seed=seed)
     return TrackingFrame.from_stream(stream, stream.n_samples - 1)
 
 
@@ -187,7 +203,7 @@ def study_run(
     if truth.fps != 90.0:
         truth = truth.resample(90.0)  # the output's clock, frame for frame
     setup = setup_for(user, noise)
-    sample = walk_in(setup, truth.skeleton, user)
+    sample = walk_in(setup, truth.skeleton, user.seed, user.heading_rad)
     stream = setup.sample(truth, seed=user.seed)
     avatar = avatar_of(truth.skeleton, user)
     out: dict = {"user": user.as_dict(), "motions": {}}

@@ -27,7 +27,7 @@ def _sample(seed: int = 0):
     """A random user's walk-in sample: straps up to 5 cm off and turned at random."""
     skeleton = subject_skeleton(sample_subject(np.random.default_rng(seed)))
     user = sample_user(seed, skeleton)
-    return walk_in(setup_for(user), skeleton, user), user
+    return walk_in(setup_for(user), skeleton, user.seed, user.heading_rad), user
 
 
 @pytest.mark.parametrize("seed", range(3))

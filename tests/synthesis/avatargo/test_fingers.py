@@ -39,7 +39,7 @@ def test_fingers_close_onto_the_handle_without_entering(seed):
 def test_thumb_button_pulls_the_thumb():
     skeleton = load_rig("avatar").skeleton
     grip = grip_of(skeleton)
-    button = grip.centre + np.array([0.0, 0.0, -CONTROLLER_RADIUS_M])  # under the handle
+    button = grip.handle.mean(1) + np.array([0.0, 0.0, -CONTROLLER_RADIUS_M])  # under it
     free, pressing = FingerIK(skeleton, grip), FingerIK(skeleton, grip, thumb_button=button)
     tips = [ik.sdf(ik.advance()) for ik in (free, pressing)]
     assert not np.allclose(pressing.t[[0, 5]], free.t[[0, 5]])

@@ -45,10 +45,13 @@ def test_exact_reconstruction_at_zero_offset_and_noise():
     """Avatar = user, trackers at the nominal spots, no noise: the goals of root, feet and
     head are the user's joints to 1e-6 m on every frame (eqs. 2-3), and the IK output sits
     on them to 1 mm (its convergence tolerance; measured 0.5 mm max on this clip)."""
+    # wave: a standing activity whose arms reach high (the hands' reach is exercised too)
     truth = generate("wave", Subject(), 1.0, 90.0, 0)
     user = ideal_user(0, heading_rad=0.7)
     setup = setup_for(user)
-    synth = AvatarGo(truth.skeleton, walk_in(setup, truth.skeleton, user), fingers=False)
+    synth = AvatarGo(
+        truth.skeleton, walk_in(setup, truth.skeleton, user.seed, user.heading_rad), fingers=False
+    )
     stream = on_clock(setup.sample(truth, seed=0))
     index = synth.device_index(FrameBatch.of_stream(stream))
     goals, _ = synth.goals(stream.positions[:, index], stream.quaternions[:, index])
@@ -61,3 +64,5 @@ def test_exact_reconstruction_at_zero_offset_and_noise():
         :, out.skeleton.indices([synth.body.rig.body17[j] for j in EFFECTORS.values()])
     ]
     assert np.linalg.norm(got - user_joints, axis=-1).max() < 1e-3
+    # The controllers sit at the palms (the user's grip is the avatar's): within 1 mm.
+    assert np.max(synth.palm_distance) < 1e-3
