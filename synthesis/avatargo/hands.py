@@ -7,10 +7,10 @@ tracked centre is held (:class:`Grip`; the simulated devices' convention,
 ``R_t(wrist) = R_t(C) R0(C)^-1 R0(wrist)`` (eq. 3 with the controller as tracker) and
 ``p_t(wrist) = p_t(C) - R_t(wrist) c``, i.e. a :class:`~synthesis.avatargo.offsets.
 TrackerOffsets` (:func:`palm_offsets`). Where the avatar's arm is too short to put the wrist
-there, the IK leaves the hand as close as it gets and the virtual controller is attached
-to the hand instead of the physical one (§3.4): :func:`palm_distance` measures how far the
-palm's controller point ended from the tracked controller, and a frame counts as unreached
-beyond :data:`REACH_TOLERANCE_M`.
+there (:func:`out_of_reach`: the wrist's goal further from the shoulder than the arm's
+length), the IK leaves the hand as close as it gets and the virtual controller is attached
+to the hand instead of the physical one (§3.4); :func:`palm_distance` measures how far the
+palm's controller point ended from the tracked controller.
 
 The controller's body is a capsule (its handle): :data:`CONTROLLER_RADIUS_M`,
 :data:`HANDLE_LENGTH_M`, lying across the palm (along the knuckle line) right under the palm
@@ -37,9 +37,9 @@ PALM_HALF_THICKNESS_M = 0.012
 deeper where a rest finger bone (the thumb's) lies further below, plus
 :data:`FINGER_CLEARANCE_M`: the open hand must not start inside the handle."""
 FINGER_CLEARANCE_M = 0.001
-REACH_TOLERANCE_M = 0.02
-"""A controller further than this from the palm point counts as unreached (our choice:
-well above the IK's residual on reachable targets, ~1 mm)."""
+REACH_SLACK_M = 0.005
+"""A wrist goal counts as out of reach beyond the arm's length plus this (our choice: the
+IK's joint limits keep the elbow a few degrees from straight)."""
 PALM_NORMAL = np.array([0.0, 0.0, -1.0])
 """Out of the palm, in the hand frame: the rigs' rest T-pose has the palms down."""
 KNUCKLES = ("Finger1", "Finger4")
@@ -119,6 +119,13 @@ def palm_distance(
 ) -> np.ndarray:
     """``(B, 2)`` metres from the palm's controller point of the solved wrists
     (``wrist_pos (B, 2, 3)``, ``wrist_rot (B, 2, 4)``) to the tracked controllers
-    ``(B, 2, 3)``; beyond :data:`REACH_TOLERANCE_M` the virtual controller is on the hand."""
+    ``(B, 2, 3)``."""
     held = wrist_pos + quat.rotate(wrist_rot, grip.palm)
     return np.linalg.norm(held - controller_pos, axis=-1)
+
+
+def out_of_reach(shoulders: np.ndarray, wrist_goals: np.ndarray, arm: np.ndarray) -> np.ndarray:
+    """``(B, 2)`` whether each wrist goal ``(B, 2, 3)`` lies beyond the arm's length
+    ``arm (2,)`` (plus :data:`REACH_SLACK_M`) from its shoulder ``(B, 2, 3)``: there the
+    virtual controller is attached to the hand (§3.4)."""
+    return np.linalg.norm(wrist_goals - shoulders, axis=-1) > arm + REACH_SLACK_M

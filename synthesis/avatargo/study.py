@@ -30,7 +30,6 @@ from avatar_models import Motion, Skeleton, quat
 from avatar_models.body import build_body
 from avatar_models.rigs import identify_rig
 from render_cams.vr import FULL_BODY, Attachment, NoiseModel, VRSetup, nominal_attachment
-from synthesis.avatargo.hands import REACH_TOLERANCE_M
 from synthesis.avatargo.synthesizer import AvatarGo
 from synthesis.base import TrackingFrame
 from synthesis.ik_baseline import rest_body_frame, stands_upright
@@ -185,7 +184,7 @@ def score(truth: Motion, output: Motion, user: SimulatedUser, synth: AvatarGo) -
         "effector_err_cm": {k: float(100 * err[:, i].mean()) for i, k in enumerate(EFFECTORS)},
         "knee_err_deg": float(np.degrees(knee_err.mean())) if knee_err.size else 0.0,
         "palm_cm": float(100 * palm.mean()) if palm.size else float("nan"),
-        "unreached_frac": float((palm > REACH_TOLERANCE_M).mean()) if palm.size else 0.0,
+        "unreached_frac": float(np.mean(synth.attached[-n:])) if synth.attached else 0.0,
     }
     if synth.finger_ik is not None:
         sdf = synth.finger_ik.sdf(synth.finger_ik.t).min(-1)  # (F,) closest point per finger

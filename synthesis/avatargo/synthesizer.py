@@ -21,8 +21,8 @@ controllers; then full-body IK with mink on the avatar's humanoid
 (:class:`~avatar_models.body.ik.HumanoidIK`, warm-started, a few QP iterations, standing in
 for Unity's IK), and finger IK on the controller handles (:mod:`synthesis.avatargo.fingers`)
 when the avatar has the avatar rig's finger bones. Where a hand ends further than
-:data:`~synthesis.avatargo.hands.REACH_TOLERANCE_M` from its controller, the virtual
-controller is drawn in the hand (reported by :attr:`AvatarGo.palm_distance`).
+:func:`~synthesis.avatargo.hands.out_of_reach`, the virtual controller is drawn in the
+hand (reported per frame by :attr:`AvatarGo.attached`, with :attr:`AvatarGo.palm_distance`).
 
 Untracked samples hold the device's last pose; before any, the avatar stands in its
 calibration T-pose.
@@ -45,7 +45,14 @@ from render_cams.vr import FULL_BODY, nominal_attachment
 from render_cams.vr.placements import EYE_OFFSET_M
 from synthesis.avatargo.calibration import Roles, classes_of, identify_roles
 from synthesis.avatargo.fingers import FingerIK
-from synthesis.avatargo.hands import Grip, grip_of, has_fingers, palm_distance, palm_offsets
+from synthesis.avatargo.hands import (
+    Grip,
+    grip_of,
+    has_fingers,
+    out_of_reach,
+    palm_distance,
+    palm_offsets,
+)
 from synthesis.avatargo.offsets import TrackerOffsets, exact_offsets, fixed_offsets
 from synthesis.avatargo.spine import spine_bend
 from synthesis.base import (
@@ -160,9 +167,15 @@ class AvatarGo(Synthesizer):
             orientation_cost=ORIENTATION_COST,
             settings=IKSettings(max_iterations=self.iterations_per_tick),
         )
-        self._wrist_sites = np.array(
-            [mujoco.mj_name2id(self.body.model, mujoco.mjtObj.mjOBJ_SITE, s) for s in SITES[5:]]
+        arm_sites = ("l_shoulder", "r_shoulder", "l_elbow", "r_elbow", "l_wrist", "r_wrist")
+        site = np.array(
+            [mujoco.mj_name2id(self.body.model, mujoco.mjtObj.mjOBJ_SITE, s) for s in arm_sites]
         )
+        self._shoulder_sites, self._wrist_sites = site[:2], site[4:]
+        self.ik.frame_positions(self.body.model.qpos0)  # the rest pose into the sites' data
+        arm = self.ik.configuration.data.site_xpos[site].reshape(3, 2, 3)
+        self._arm_length = np.linalg.norm(np.diff(arm, axis=0), axis=-1).sum(0)  # (2,)
+
         self.finger_ik = (
             FingerIK(self.body.skeleton, self.grip)
             if fingers and has_fingers(self.body.skeleton)
@@ -238,6 +251,10 @@ class AvatarGo(Synthesizer):
         self.palm_distance: list[np.ndarray] = []
         """Per frame so far, ``(2,)`` metres from each palm's controller point to the tracked
         controller (:func:`~synthesis.avatargo.hands.palm_distance`)."""
+        self.attached: list[np.ndarray] = []
+        """Per frame so far, ``(2,)`` whether the controller was out of the arm's reach and
+        the virtual controller drawn in the hand (:func:`~synthesis.avatargo.hands.
+        out_of_reach`)."""
         if self.finger_ik is not None:
             self.finger_ik.reset()
 
@@ -279,6 +296,8 @@ class AvatarGo(Synthesizer):
                 wrist = data.site_xpos[self._wrist_sites]
                 wrist_rot = quat.from_matrix(data.site_xmat[self._wrist_sites].reshape(2, 3, 3))
                 self.palm_distance.append(palm_distance(wrist, wrist_rot, pos[b, hand], self.grip))
+                shoulders = data.site_xpos[self._shoulder_sites]
+                self.attached.append(out_of_reach(shoulders, goal_pos[b, 5:], self._arm_length))
             qpos[b] = self._q
             if self.finger_ik is not None:
                 fingers.append(self.finger_ik.advance().copy())
