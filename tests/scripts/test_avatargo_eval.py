@@ -28,7 +28,7 @@ def test_eval_avatargo_builtin_writes_json_and_plot(tmp_path):
     result = runner.invoke(
         app,
         ["eval", "avatargo", "--quick", "--subjects", "1", "--takes", "1", "--duration",
-         "1.0", "--out", str(out), "--json", str(js)],
+         "0.5", "--out", str(out), "--json", str(js)],
     )  # fmt: skip
     assert result.exit_code == 0, result.output
     payload = json.loads(js.read_text())

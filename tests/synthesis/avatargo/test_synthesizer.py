@@ -16,7 +16,7 @@ from synthesis.methods import MethodInputs, build
 
 @pytest.fixture(scope="module")
 def session():
-    truth = generate("wave", Subject(), 0.5, 90.0, 0)
+    truth = generate("wave", Subject(), 0.25, 90.0, 0)
     user = sample_user(5, truth.skeleton)
     setup = setup_for(user)
     sample = walk_in(setup, truth.skeleton, user.seed, user.heading_rad)
