@@ -44,6 +44,8 @@ PENETRATION_PENALTY = 10.0
 much as one 1 cm away, so the optimum lies on the surface, outside)."""
 LEARNING_RATE = 2.0
 """Initial ``eta`` of eq. 7 (units of t per metre of cost; our choice)."""
+MAX_LEARNING_RATE = 50.0 * LEARNING_RATE
+"""Cap of the growing step size (a full open-to-closed swing per step at ~2 cm of cost)."""
 GRADIENT_STEP = 1e-4
 """Central-difference step in ``t``."""
 SETTLE_ITERATIONS = 150
@@ -183,7 +185,8 @@ class FingerIK:
             trial = np.clip(self.t - self._eta[:, None] * grad, 0.0, 1.0)
             better = self.cost(trial) < costs[0]
             self.t = np.where(better[:, None], trial, self.t)
-            self._eta = np.where(better, 1.5 * self._eta, 0.5 * self._eta)
+            grown = np.minimum(1.5 * self._eta, MAX_LEARNING_RATE)
+            self._eta = np.where(better, grown, 0.5 * self._eta)
         return self.t
 
     def advance(self) -> np.ndarray:
