@@ -9,7 +9,9 @@ Construction is the Walk-In-Avatar step (§3.2-3.3) on one T-pose sample of the 
    T-pose where the user stands, facing where the user faces, the headset centred in its
    head (the user "walks into" it; in simulation we place the avatar on the user instead);
 3. the offsets of the joints in their devices' frames at t = 0: exact ones for the root,
-   feet and head (eqs. 2-3, :func:`~synthesis.avatargo.offsets.exact_offsets`) or, for the
+   feet and head (eqs. 2-3, :func:`~synthesis.avatargo.offsets.exact_offsets`; §3.3 names
+   root and feet and takes the head's rotation from the headset, we give the head's
+   position the same exact offset so that the headset's fit cancels too) or, for the
    ``fixed`` baseline, the nominal constant ones for the root and feet
    (:func:`~synthesis.avatargo.offsets.fixed_offsets`); the wrists at the exact
    palm-to-wrist offset under the controllers (:mod:`synthesis.avatargo.hands`); and
@@ -20,12 +22,13 @@ offsets, the spine's bend ``alpha_t`` (eq. 4) as the neck's goal, the wrists fro
 controllers; then full-body IK with mink on the avatar's humanoid
 (:class:`~avatar_models.body.ik.HumanoidIK`, warm-started, a few QP iterations, standing in
 for Unity's IK), and finger IK on the controller handles (:mod:`synthesis.avatargo.fingers`)
-when the avatar has the avatar rig's finger bones. Where a hand ends further than
-:func:`~synthesis.avatargo.hands.out_of_reach`, the virtual controller is drawn in the
-hand (reported per frame by :attr:`AvatarGo.attached`, with :attr:`AvatarGo.palm_distance`).
+when the avatar has the avatar rig's finger bones. Where a controller is out of the arm's
+reach (:func:`~synthesis.avatargo.hands.out_of_reach`), the virtual controller is drawn in
+the hand (reported per frame by :attr:`AvatarGo.attached`, with
+:attr:`AvatarGo.palm_distance`).
 
-Untracked samples hold the device's last pose; before any, the avatar stands in its
-calibration T-pose.
+Untracked samples hold the device's last pose; until every device has been tracked once,
+the avatar stands in its calibration T-pose.
 """
 
 from __future__ import annotations
