@@ -54,13 +54,18 @@ def flatten(scores: dict) -> dict[str, float]:
 
 
 def summarise(rows: Sequence[dict]) -> dict:
-    """Means over users per variant, and how often exact beat fixed on the leg artefact."""
+    """Means over users per variant, and how often exact beat fixed on the leg artefact
+    (among the users whose avatar legs differ and who stand at some point)."""
     summary = {}
     for kind in VARIANTS:
         flat = [flatten(r[kind]) for r in rows]
         keys = [k for k in flat[0] if all(k in f for f in flat)]
         summary[kind] = {k: float(np.nanmean([f[k] for f in flat])) for k in keys}
-    legs = [r for r in rows if abs(r["user"]["leg_scale"] - 1.0) > 0.01]
+    legs = [
+        r
+        for r in rows
+        if abs(r["user"]["leg_scale"] - 1.0) > 0.01 and r["exact"]["standing_frames"] > 0
+    ]
     summary["exact_beats_fixed_knee"] = (
         f"{sum(r['exact']['knee_err_deg'] < r['fixed']['knee_err_deg'] for r in legs)}/{len(legs)}"
     )

@@ -116,7 +116,7 @@ def write_avatargo(results: dict, out: Path, json_out: Path | None) -> None:
     console.print(_avatargo_table(results))
     console.print(
         f"exact beat fixed on the knee error for {results['overall']['exact_beats_fixed_knee']}"
-        " users whose avatar legs differ"
+        " standing users whose avatar legs differ"
     )
     out.mkdir(parents=True, exist_ok=True)
     results["plot"] = str(write_plot(results, out / "avatargo.png"))
