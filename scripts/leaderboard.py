@@ -22,9 +22,11 @@ import numpy as np
 
 from avatar_models.measure import standing_height
 from render_cams import VRSetup
+from render_cams.vr import FULL_BODY
 from scripts.method_score import score_method
 from scripts.report_html import image_html, page, table_html
 from sim.thresholds import CheckConfig
+from synthesis.avatargo.study import walk_in
 from synthesis.base import SynthesisError
 from synthesis.evaluate import (
     EvaluationError,
@@ -78,11 +80,17 @@ def fold_rows(fold, setup: VRSetup, methods: Sequence[str], checks: CheckConfig,
         overrides["max_distance"] = choose_max_distance(fold.train, fold.protocol, coolmoves, setup)
     database = cache(lambda: database_for(fold.train))
     out = []
+    trackers = set(FULL_BODY) <= set(setup.devices)
     for trial in fold.test:
         stream = setup.sample(trial.motion, seed=trial.seed)
         rig, calibration = ik_rig_for(database().skeleton, trial.motion, setup)
         inputs = MethodInputs(
-            database, standing_height(trial.motion), rig, calibration, dict(overrides)
+            database,
+            standing_height(trial.motion),
+            rig,
+            calibration,
+            dict(overrides),
+            walk_in(setup, trial.motion.skeleton, trial.seed) if trackers else None,
         )
         for name in methods:
             result = score_method(build(name, inputs), trial.motion, stream, checks, True)
@@ -113,7 +121,8 @@ def run_leaderboard(
     all_folds, skipped = folds(trials, protocol)
     if not all_folds:
         raise EvaluationError(f"no class can be evaluated {protocol}: {skipped}")
-    setup, checks = setup or VRSetup(), checks or CheckConfig()
+    # Every device, Vive trackers included (AvatarGo's); the others read only theirs.
+    setup, checks = setup or VRSetup(devices=FULL_BODY), checks or CheckConfig()
     rows, failed = [], []
     for i, fold in enumerate(all_folds):
         try:

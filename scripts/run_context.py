@@ -13,6 +13,7 @@ from render_cams.tracking import TrackingStream
 from scripts.results import ThresholdResult
 from scripts.scenario import Scenario
 from sim.humanoid import Humanoid
+from synthesis.base import TrackingFrame
 
 
 @dataclass
@@ -24,6 +25,9 @@ class RunContext:
         humanoid: its body, built once (stage ``body``) and used by every later stage.
         vr_stream: the simulated VR tracking stream (stage ``devices``; None without
             ``[devices] vr``), the synthesisers' input.
+        walk_in: the VR devices' sample while the user stands in a T-pose before the session
+            (stage ``devices``, with ``[devices] trackers``; None without), AvatarGo's
+            walk-in calibration.
         synthesised: each method's output on the humanoid, by method name (stage
             ``synthesis``; empty without ``[synthesis]``).
         metrics: thresholded by ``[thresholds]``.
@@ -38,6 +42,7 @@ class RunContext:
     motion: Motion | None = None
     humanoid: Humanoid | None = None
     vr_stream: TrackingStream | None = None
+    walk_in: TrackingFrame | None = None
     synthesised: dict[str, Humanoid] = field(default_factory=dict)
     metrics: dict[str, float] = field(default_factory=dict)
     checks: list[ThresholdResult] = field(default_factory=list)

@@ -18,7 +18,8 @@ from functools import cached_property
 
 from avatar_models import Skeleton
 from render_cams.vr import Attachment
-from synthesis.base import SynthesisError, Synthesizer
+from synthesis.avatargo import AvatarGo
+from synthesis.base import SynthesisError, Synthesizer, TrackingFrame
 from synthesis.coolmoves import CoolMoves, Database, Options
 from synthesis.ik_baseline import IKBaseline
 
@@ -39,6 +40,9 @@ class MethodInputs:
             position only (the rigs' hand frames differ).
         coolmoves: option overrides for every CoolMoves variant (e.g. a scenario's
             ``foot_contact``), applied on top of the variant's own.
+        walk_in: AvatarGo's walk-in sample (§3.2): the six devices (headset, controllers,
+            three Vive trackers) while the user stands in a T-pose, or None where the
+            trackers are off.
     """
 
     database_factory: Callable[[], Database]
@@ -46,6 +50,7 @@ class MethodInputs:
     rig: Skeleton
     calibration: Sequence[Attachment] | None = None
     coolmoves: dict = field(default_factory=dict)
+    walk_in: TrackingFrame | None = None
 
     @cached_property
     def database(self) -> Database:
@@ -83,6 +88,23 @@ def ik_baseline(inputs: MethodInputs) -> Synthesizer:
     return IKBaseline(inputs.rig, inputs.user_height_m, inputs.calibration, own)
 
 
+def avatargo(name: str, summary: str, offsets: str) -> Method:
+    """AvatarGo with ``offsets`` on the scored rig as the avatar, calibrated on the inputs'
+    walk-in sample (:class:`~synthesis.avatargo.AvatarGo`)."""
+
+    def build(inputs: MethodInputs) -> Synthesizer:
+        if inputs.walk_in is None:
+            raise SynthesisError(
+                f"{name} needs the three Vive trackers and their walk-in T-pose sample: "
+                "enable [devices] trackers = true"
+            )
+        synth = AvatarGo(inputs.rig, inputs.walk_in, offsets=offsets)
+        synth.name = name
+        return synth
+
+    return Method(name, summary, build)
+
+
 METHODS: dict[str, Method] = {
     m.name: m
     for m in (
@@ -101,6 +123,16 @@ METHODS: dict[str, Method] = {
             Options(align_about_centroid=True),
         ),
         Method("ik", "VRIK-like full-body IK from headset and controllers (§4.1.1)", ik_baseline),
+        avatargo(
+            "avatargo",
+            "AvatarGo: walk-in calibration, exact tracker offsets, IK, finger IK (§3)",
+            "exact",
+        ),
+        avatargo(
+            "avatargo-fixed",
+            "AvatarGo with the fixed root/feet tracker offsets it argues against (§3.3)",
+            "fixed",
+        ),
     )
 }
 """Every registered method by name (AvatarGo, MoveBox and ControllerPose join as they land)."""

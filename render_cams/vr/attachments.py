@@ -8,8 +8,9 @@ device's world pose is the joint's global pose composed with the offset::
 Joint frames: every avatarsim rig has identity local rotations in its rest pose, so at rest a
 joint's frame is the body frame (+X forward, +Y left, +Z up) whatever the rig; offsets are
 therefore rig-independent where they are written in that frame. Users wear devices a little
-differently; AvatarGo (shared/papers/avatargo.txt §3.3) computes these per-user offsets by
-calibration, and :class:`OffsetSpread` draws them for simulated users.
+differently; :class:`OffsetSpread` draws such per-user offsets for simulated users (AvatarGo,
+shared/papers/avatargo.txt §3.3, calibrates the trackers' offsets to the avatar's joints at a
+T-pose instead, :mod:`synthesis.avatargo`).
 """
 
 from __future__ import annotations

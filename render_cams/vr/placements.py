@@ -5,7 +5,9 @@ three Vive trackers, on both feet and on the lower back. CoolMoves (coolmoves.tx
 first three only. Offsets are written in the body frame at rest (+X forward, +Y left, +Z up;
 see :mod:`render_cams.vr.attachments`). They are plausible adult values chosen here, not
 measurements; per-user variation is added by :class:`~render_cams.vr.attachments.OffsetSpread`
-and calibration (AvatarGo) estimates them back.
+or by explicit per-device ``offsets`` (:class:`~render_cams.vr.setup.VRSetup`). Nothing here
+calibrates: AvatarGo's walk-in calibration (:mod:`synthesis.avatargo`) does not estimate these
+offsets back, it stores each tracker's offset to the avatar's joint at a T-pose (§3.3).
 
 - ``hmd``: on the head joint, 9 cm forward and 8 cm up (between the eyes, where the headset's
   tracking origin is), looking along +X with +Z up.

@@ -16,6 +16,7 @@ BENCHMARKS: dict[str, str] = {
     "formats": "formats",
     "checks": "checks",
     "coolmoves": "coolmoves",
+    "avatargo": "avatargo",
     "cameras": "cameras",
     "sensing": "sensing",
     "kinect": "kinect",

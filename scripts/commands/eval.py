@@ -3,7 +3,9 @@
 CoolMoves' accuracy protocols (§4.1) with the IK baseline beside: prints the per-class and
 overall tables, writes the contract JSON and Fig. 4-like bar plots into ``--out``.
 ``eval leaderboard`` runs every registered method instead (:mod:`scripts.leaderboard`) and
-writes ``leaderboard.json``, ``.png`` and ``.html``. Exit 2 for
+writes ``leaderboard.json``, ``.png`` and ``.html``; ``eval avatargo`` runs AvatarGo's
+simulated user study, exact against fixed offsets (:mod:`scripts.avatargo_eval`), and
+writes ``avatargo.json`` and ``avatargo.png``. Exit 2 for
 bad input (unknown method or protocol, a folder without clips, cross-subject on clips
 without subject labels).
 """
@@ -83,6 +85,46 @@ def write_leaderboard(board: dict, out: Path, json_out: Path | None) -> None:
     console.print(f"wrote {out}/leaderboard.json, leaderboard.png and leaderboard.html")
 
 
+def _avatargo_table(results: dict) -> Table:
+    from synthesis.avatargo.study import EFFECTORS
+
+    table = Table(title=f"avatargo, {len(results['users'])} simulated users (exact / fixed)")
+    columns = [f"effector_err_cm.{k}" for k in EFFECTORS] + [
+        "knee_err_deg",
+        "palm_cm",
+        "unreached_frac",
+        "finger_penetration_mm",
+        "finger_gap_mm",
+        "physics.penetration_cm_p95",
+        "physics.skate_cm_s_median",
+        "physics.joint_limit_violation_frac",
+    ]
+    table.add_column("measure")
+    table.add_column("exact", justify="right")
+    table.add_column("fixed", justify="right")
+    overall = results["overall"]
+    for key in columns:
+        if key in overall["exact"]:
+            table.add_row(key, f"{overall['exact'][key]:.3g}", f"{overall['fixed'][key]:.3g}")
+    return table
+
+
+def write_avatargo(results: dict, out: Path, json_out: Path | None) -> None:
+    """Print AvatarGo's study table; write its JSON and plot into ``out``."""
+    from scripts.avatargo_eval import write_plot
+
+    console.print(_avatargo_table(results))
+    console.print(
+        f"exact beat fixed on the knee error for {results['overall']['exact_beats_fixed_knee']}"
+        " standing users whose avatar legs differ"
+    )
+    out.mkdir(parents=True, exist_ok=True)
+    results["plot"] = str(write_plot(results, out / "avatargo.png"))
+    emit_json(out / "avatargo.json", results)
+    emit_json(json_out, results)
+    console.print(f"wrote {out}/avatargo.json and avatargo.png")
+
+
 def register(app: typer.Typer) -> None:
     @app.command(name="eval")
     @user_errors
@@ -91,8 +133,10 @@ def register(app: typer.Typer) -> None:
             str,
             typer.Argument(
                 help="coolmoves (the paper's), coolmoves+arm-ik, coolmoves-gmm, "
-                "coolmoves-centroid-align (synthesis.methods), or leaderboard: every "
-                "registered method on the same test motions, accuracy, physics and latency."
+                "coolmoves-centroid-align (synthesis.methods), leaderboard: every "
+                "registered method on the same test motions, accuracy, physics and latency, "
+                "or avatargo: its simulated user study, exact vs fixed offsets (one user "
+                "per test motion)."
             ),
         ],
         library: Annotated[
@@ -127,6 +171,7 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Accuracy protocols of a synthesis method, IK baseline beside (CoolMoves §4.1), or
         ``leaderboard``: every registered method (scripts/leaderboard.py)."""
+        from scripts.avatargo_eval import BUILTIN_ACTIVITIES, run_avatargo_eval
         from scripts.leaderboard import run_leaderboard
         from synthesis.evaluate import (
             EVALUABLE,
@@ -149,13 +194,16 @@ def register(app: typer.Typer) -> None:
             if not lo <= value <= hi:  # also NaN
                 raise EvaluationError(f"{option} must be {lo:g}-{hi:g}, got {value}")
         check_outputs(json_out=json_out, out=out)
-        if method not in (*EVALUABLE, "leaderboard"):
+        if method not in (*EVALUABLE, "leaderboard", "avatargo"):
             raise EvaluationError(
-                f"unknown method {method!r}; available: {', '.join(EVALUABLE)}, leaderboard"
+                f"unknown method {method!r}; available: {', '.join(EVALUABLE)}, leaderboard, "
+                "avatargo"
             )
         if protocol not in PROTOCOLS:
             raise EvaluationError(f"unknown protocol {protocol!r}; use {' or '.join(PROTOCOLS)}")
         wanted = None if classes is None else [c.strip() for c in classes.split(",") if c.strip()]
+        if method == "avatargo" and wanted is None and library == "builtin":
+            wanted = list(BUILTIN_ACTIVITIES[:1] if quick else BUILTIN_ACTIVITIES)
         if quick:
             subjects, takes, duration = min(subjects, 3), min(takes, 2), min(duration, 3.0)
             max_per_class = min(max_per_class or 6, 6)
@@ -176,6 +224,11 @@ def register(app: typer.Typer) -> None:
             def progress(done: int, total: int, label: str) -> None:
                 bar.update(task, completed=done, total=total, description=escape(label))
 
+            if method == "avatargo":
+                results = run_avatargo_eval(trials, duration, progress=progress)
+                results.update(library=library, seed=seed, quick=quick, class_by=class_by)
+                write_avatargo(results, out, json_out)
+                return
             if method == "leaderboard":
                 board = run_leaderboard(trials, protocol, progress=progress)
                 board.update(library=library, seed=seed, quick=quick, class_by=class_by)

@@ -7,6 +7,7 @@ from render_cams.vr.dropouts import Dropouts
 from render_cams.vr.noise import Drift, Latency, PositionJitter, RotationJitter
 from scripts.run_context import RunContext
 from scripts.scenario import Scenario
+from synthesis.avatargo.study import walk_in
 
 METRICS = {"vr_valid_frac": "share of valid VR samples over all devices"}
 
@@ -38,6 +39,8 @@ def run(ctx: RunContext) -> None:
     vr = setup(ctx)
     stream = vr.sample(ctx.motion, seed=ctx.scenario.seed)
     ctx.vr_stream = stream
+    if ctx.scenario.devices.trackers:  # AvatarGo's walk-in T-pose, with the same devices
+        ctx.walk_in = walk_in(vr, ctx.motion.skeleton, ctx.scenario.seed)
     ctx.metrics["vr_valid_frac"] = float(stream.valid.mean())
     ctx.info["devices"] = {
         "vr": list(stream.device_names),

@@ -1,0 +1,87 @@
+"""AvatarGo speed: per-frame ``step()`` latency at 90 Hz on one core, whole and by part.
+
+Input: a sampled user (:mod:`synthesis.avatargo.study`) waving for 4 s (2 s in ``quick``
+mode) with the six devices and realistic VR noise. Latency is the wall time of each
+``step()`` call with BLAS on one thread and the process pinned to one CPU where the OS
+allows. Rows: the whole step of ``avatargo`` (aim: p99 under 1 ms, issue 13) and of the IK
+baseline ``ik`` in the same process; then the parts of one AvatarGo tick, timed alone: the
+goals (eqs. 2-4, hands), the mink IK solve, and the finger IK (numeric gradient, eq. 7).
+The paper (§5) reports no latency; the 90 Hz frame (11.1 ms) is the hard budget.
+"""
+
+from __future__ import annotations
+
+import os
+from contextlib import contextmanager
+
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from avatar_models.generator import generate, sample_subject
+from render_cams.vr import FULL_BODY
+from scripts.benchmarks import BenchRow, best_of
+from scripts.stages.devices import REALISTIC_NOISE
+from synthesis.avatargo import AvatarGo
+from synthesis.avatargo.study import sample_user, setup_for, walk_in
+from synthesis.base import FrameBatch, on_clock
+from synthesis.ik_baseline import IKBaseline
+from synthesis.scoring import step_latencies_ms
+
+AIM_MS = 1.0
+FRAME_BUDGET_MS = 1000.0 / 90.0
+
+
+@contextmanager
+def one_core():
+    """BLAS on one thread and, where the OS allows, the process on one CPU."""
+    pin = hasattr(os, "sched_getaffinity")
+    cpus = os.sched_getaffinity(0) if pin else None
+    if pin:
+        os.sched_setaffinity(0, {min(cpus)})
+    try:
+        with threadpool_limits(1, user_api="blas"):
+            yield
+    finally:
+        if pin:
+            os.sched_setaffinity(0, cpus)
+
+
+def run(quick: bool = False) -> list[BenchRow]:
+    truth = generate("wave", sample_subject(np.random.default_rng(0)), 2.0 if quick else 4.0)
+    user = sample_user(0, truth.skeleton)
+    setup = setup_for(user, REALISTIC_NOISE)
+    stream = setup.sample(truth, seed=user.seed)
+    synth = AvatarGo(truth.skeleton, walk_in(setup, truth.skeleton, user.seed, user.heading_rad))
+    baseline = IKBaseline(truth.skeleton, None)
+    clocked = on_clock(stream)
+    batch = FrameBatch.of_stream(clocked)
+    index = synth.device_index(batch)
+    pos, rot = clocked.positions[-1:, index], clocked.quaternions[-1:, index]
+    with one_core():
+        lat = step_latencies_ms(synth, stream)
+        ik_lat = step_latencies_ms(baseline, stream)
+        goals_s = best_of(lambda: synth.goals(pos, rot), repeat=50)
+        goal_pos, goal_rot = synth.goals(pos, rot)
+        start = synth.ik.fitted_root(goal_pos[0])
+        solve_s = best_of(
+            lambda: synth.ik.solve_frame(goal_pos[0], start, goal_rot[0], 2), repeat=20
+        )
+        fingers_s = best_of(synth.finger_ik.advance, repeat=50)
+    note = f"{stream.n_samples} frames, {len(FULL_BODY)} devices, realistic noise, one core"
+    p50, p99 = (float(np.percentile(lat, q)) for q in (50, 99))
+    return [
+        BenchRow("avatargo step p50", "ms", p50, AIM_MS, "issue 13 aim (1 ms)", note),
+        BenchRow("avatargo step p99", "ms", p99, AIM_MS, "issue 13 aim (1 ms)", note),
+        BenchRow("avatargo step p99 vs frame", "ms", p99, FRAME_BUDGET_MS, "90 Hz frame", note),
+        BenchRow(
+            "ik baseline step p99",
+            "ms",
+            float(np.percentile(ik_lat, 99)),
+            FRAME_BUDGET_MS,
+            "90 Hz frame",
+            note,
+        ),
+        BenchRow("avatargo goals (eqs. 2-4)", "ms", 1e3 * goals_s, p50, "avatargo step p50"),
+        BenchRow("avatargo mink IK, 2 iterations", "ms", 1e3 * solve_s, p50, "avatargo step p50"),
+        BenchRow("avatargo finger IK tick", "ms", 1e3 * fingers_s, p50, "avatargo step p50"),
+    ]

@@ -1,0 +1,322 @@
+"""``AvatarGo``: the self-avatar of AvatarGo (shared/papers/avatargo.txt §3) as a Synthesizer.
+
+Construction is the Walk-In-Avatar step (§3.2-3.3) on one T-pose sample of the six devices
+(:class:`~synthesis.base.TrackingFrame`):
+
+1. roles and eye height from the plane through the devices
+   (:func:`~synthesis.avatargo.calibration.identify_roles`);
+2. the avatar scaled uniformly so that its eye height is the headset's, stood in its
+   T-pose where the user stands, facing where the user faces, the headset centred in its
+   head (the user "walks into" it; in simulation we place the avatar on the user instead);
+3. the offsets of the joints in their devices' frames at t = 0: exact ones for the root,
+   feet and head (eqs. 2-3, :func:`~synthesis.avatargo.offsets.exact_offsets`; §3.3 names
+   root and feet and takes the head's rotation from the headset, we give the head's
+   position the same exact offset so that the headset's fit cancels too) or, for the
+   ``fixed`` baseline, the nominal constant ones for the root and feet
+   (:func:`~synthesis.avatargo.offsets.fixed_offsets`); the wrists at the exact
+   palm-to-wrist offset under the controllers (:mod:`synthesis.avatargo.hands`); and
+   ``w0`` (eq. 1) for the spine.
+
+Each tick (§3.4): end-effector goals for the root (pelvis), ankles and head from the
+offsets, the spine's bend ``alpha_t`` (eq. 4) as the neck's goal, the wrists from the
+controllers; then full-body IK with mink on the avatar's humanoid
+(:class:`~avatar_models.body.ik.HumanoidIK`, warm-started, a few QP iterations, standing in
+for Unity's IK), and finger IK on the controller handles (:mod:`synthesis.avatargo.fingers`)
+when the avatar has the avatar rig's finger bones. Where a controller is out of the arm's
+reach (:func:`~synthesis.avatargo.hands.out_of_reach`), the virtual controller is drawn in
+the hand (reported per frame by :attr:`AvatarGo.attached`, with
+:attr:`AvatarGo.palm_distance`).
+
+Untracked samples hold the device's last pose; until every device has been tracked once,
+the avatar stands in its calibration T-pose.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+from threadpoolctl import threadpool_limits
+
+from avatar_models import Motion, Skeleton, quat
+from avatar_models.body import BodyDescription, build_body
+from avatar_models.body.ik import HumanoidIK, IKSettings, motion_from_qpos
+from avatar_models.rigs import identify_rig
+from render_cams import TrackingStream
+from render_cams.vr import FULL_BODY, nominal_attachment
+from render_cams.vr.placements import EYE_OFFSET_M
+from synthesis.avatargo.calibration import Roles, classes_of, identify_roles
+from synthesis.avatargo.fingers import FingerIK
+from synthesis.avatargo.hands import (
+    Grip,
+    grip_of,
+    has_fingers,
+    out_of_reach,
+    palm_distance,
+    palm_offsets,
+)
+from synthesis.avatargo.offsets import TrackerOffsets, exact_offsets, fixed_offsets
+from synthesis.avatargo.spine import spine_bend
+from synthesis.base import (
+    DEFAULT_RATE_HZ,
+    FrameBatch,
+    Poses,
+    SynthesisError,
+    Synthesizer,
+    TrackingFrame,
+)
+
+SITES = ("head", "l_ankle", "r_ankle", "pelvis", "neck", "l_wrist", "r_wrist")
+"""The humanoid's body17 sites the IK steers, in goal order: the tracked joints first, in
+the order of :data:`TRACKED` (head, feet, root), then the spine and the wrists."""
+TRACKED = ("hmd", "left_foot_tracker", "right_foot_tracker", "back_tracker")
+"""Devices with a tracker-to-joint offset (eqs. 2-3), one per site of :data:`SITES`."""
+HANDS = ("left_controller", "right_controller")
+POSITION_COST = np.array([10.0, 10.0, 10.0, 10.0, 0.3, 10.0, 10.0])
+ORIENTATION_COST = np.array([0.1, 1.0, 1.0, 1.0, 0.0, 0.03, 0.03])
+"""Head, feet, root and wrists are the paper's goals (Unity IK effectors plus root and head,
+§3.4), positions first; the spine's bend is a soft hint. The root's and feet's rotations
+(eq. 3) hold the pelvis and so the knees: at 0.3 a standing user's knees came out 17 deg
+off (seed 0 wave) against 0.8 deg at 1.0. The wrists' and head's rotations weigh little
+(mink weighs 1 rad like 1 m): with the wrists' at 0.3 the QP stuck in twisted-forearm
+minima on the generator's boxing, head 9-11 cm and palms 25-30 cm off although the truth's
+pose meets every goal (at 0.03: under 1 cm). Tuned on wave (seeds 0, 2) and box (seed 1)."""
+ITERATIONS_PER_TICK = 2
+"""QP iterations per 90 Hz tick after the first (warm start; the goals move < 2 cm a tick)."""
+FIRST_ITERATIONS = 40
+"""QP iterations of the first tick, from the T-pose rigidly fitted to the goals."""
+OFFSET_KINDS = ("exact", "fixed")
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """What the walk-in step stores (§3.3): see the module docstring.
+
+    Attributes:
+        roles: the identified devices.
+        scale: the avatar's uniform scale.
+        root_pos: ``(3,)`` the avatar's root in its walk-in T-pose.
+        tracked: joint-in-device offsets of :data:`TRACKED`.
+        hands: wrist-in-controller offsets (left, right).
+        w0: ``(3,)`` eq. 1, back tracker to headset.
+        spine0: ``(3,)`` the avatar's pelvis-to-neck vector in the T-pose.
+    """
+
+    roles: Roles
+    scale: float
+    root_pos: np.ndarray
+    tracked: TrackerOffsets
+    hands: TrackerOffsets
+    w0: np.ndarray
+    spine0: np.ndarray
+
+
+def eye_height(body: BodyDescription) -> float:
+    """Height of the headset's eye point (:data:`~render_cams.vr.placements.EYE_OFFSET_M`
+    on the head) of ``body`` standing in its rest pose."""
+    sk = body.skeleton
+    head = sk.rest_positions()[sk.index(body.rig.body17["head"])]
+    return body.root_height + head[2] + EYE_OFFSET_M[2]
+
+
+def _first_usable(values: np.ndarray, ok: np.ndarray, last: np.ndarray) -> np.ndarray:
+    """``values (B, D, n)`` with each unusable sample replaced by the device's latest usable
+    one before it in the batch, or by ``last (D, n)`` (the previous batch's)."""
+    b = values.shape[0]
+    latest = np.where(ok, np.arange(b)[:, None], -1)
+    latest = np.maximum.accumulate(latest, axis=0)  # (B, D) index of the last usable sample
+    filled = np.take_along_axis(values, np.maximum(latest, 0)[..., None], axis=0)
+    return np.where((latest >= 0)[..., None], filled, last[None])
+
+
+class AvatarGo(Synthesizer):
+    """AvatarGo on ``avatar`` (any rig :func:`build_body` accepts), calibrated on ``walk_in``.
+
+    Args:
+        avatar: the avatar's skeleton, in its own proportions (scaled here from eye height).
+        walk_in: the T-pose sample of the six devices (any order; the names say only each
+            device's class, :func:`~synthesis.avatargo.calibration.device_class`).
+        offsets: ``"exact"`` (AvatarGo) or ``"fixed"`` (the baseline for root and feet).
+        fingers: pose the fingers on the controllers (when the avatar has finger bones).
+        iterations_per_tick: QP iterations per tick after the first.
+
+    Raises:
+        CalibrationError: the walk-in sample does not identify the devices.
+        SynthesisError: unknown ``offsets``.
+    """
+
+    name = "avatargo"
+
+    def __init__(
+        self,
+        avatar: Skeleton,
+        walk_in: TrackingFrame,
+        offsets: str = "exact",
+        fingers: bool = True,
+        iterations_per_tick: int = ITERATIONS_PER_TICK,
+    ):
+        if offsets not in OFFSET_KINDS:
+            raise SynthesisError(f"offsets must be one of {OFFSET_KINDS}, got {offsets!r}")
+        self.offsets = offsets
+        positions = np.where(np.asarray(walk_in.valid)[:, None], walk_in.positions, np.nan)
+        roles = identify_roles(positions, walk_in.quaternions, classes_of(walk_in.device_names))
+        self.devices = tuple(walk_in.device_names[i] for i in roles.index)
+        scale = roles.eye_height_m / eye_height(build_body(avatar))
+        self.body = build_body(avatar.scaled(scale))
+        self.grip: Grip = grip_of(self.body.skeleton)
+        self.calibration = self._calibrate(roles, scale, positions, walk_in.quaternions)
+        self.iterations_per_tick = int(iterations_per_tick)
+        self.ik = HumanoidIK(
+            self.body.model,
+            SITES,
+            position_cost=POSITION_COST,
+            orientation_cost=ORIENTATION_COST,
+            settings=IKSettings(max_iterations=self.iterations_per_tick),
+        )
+        arm_sites = ("l_shoulder", "r_shoulder", "l_elbow", "r_elbow", "l_wrist", "r_wrist")
+        site = np.array(
+            [mujoco.mj_name2id(self.body.model, mujoco.mjtObj.mjOBJ_SITE, s) for s in arm_sites]
+        )
+        self._shoulder_sites, self._wrist_sites = site[:2], site[4:]
+        self.ik.frame_positions(self.body.model.qpos0)  # the rest pose into the sites' data
+        arm = self.ik.configuration.data.site_xpos[site].reshape(3, 2, 3)
+        self._arm_length = np.linalg.norm(np.diff(arm, axis=0), axis=-1).sum(0)  # (2,)
+
+        self.finger_ik = (
+            FingerIK(self.body.skeleton, self.grip)
+            if fingers and has_fingers(self.body.skeleton)
+            else None
+        )
+        self.reset()
+
+    # -- walk-in ----------------------------------------------------------------------------
+    def _calibrate(
+        self, roles: Roles, scale: float, positions: np.ndarray, quaternions: np.ndarray
+    ) -> Calibration:
+        """§3.2-3.3 on the role-ordered walk-in sample (see :class:`Calibration`)."""
+        sk = self.body.skeleton
+        rig = identify_rig(sk)
+        heading = roles.heading
+        rest = sk.rest_positions()
+        joint = {n: rest[sk.index(rig.body17[n])] for n in SITES}
+        p = positions[roles.index]
+        q = quat.normalize(np.asarray(quaternions, float)[roles.index])
+        eye = EYE_OFFSET_M * scale
+        # The headset centred in the avatar's head, the feet on the floor (§3.2).
+        root = p[0] - quat.rotate(heading, joint["head"] + eye)
+        root[2] = self.body.root_height
+        placed = {n: root + quat.rotate(heading, v) for n, v in joint.items()}
+        role = dict(zip(FULL_BODY, range(len(FULL_BODY)), strict=True))
+        device = [role[d] for d in TRACKED]
+        joint_pos0 = np.stack([placed[s] for s in SITES[:4]])
+        heading4 = np.tile(heading, (4, 1))
+        tracked = exact_offsets(p[device], q[device], joint_pos0, heading4)
+        if self.offsets == "fixed":
+            nominal = fixed_offsets([nominal_attachment(d, sk) for d in TRACKED[1:]], scale)
+            tracked = TrackerOffsets(
+                np.concatenate([tracked.position[:1], nominal.position]),
+                np.concatenate([tracked.rotation[:1], nominal.rotation]),
+            )
+        hand = [role[d] for d in HANDS]
+        hands = palm_offsets(q[hand], np.tile(heading, (2, 1)), self.grip)
+        return Calibration(
+            roles,
+            float(scale),
+            root,
+            tracked,
+            hands,
+            w0=p[role["hmd"]] - p[role["back_tracker"]],
+            spine0=placed["neck"] - placed["pelvis"],
+        )
+
+    def t_pose(self) -> np.ndarray:
+        """``(nq,)`` the avatar's walk-in T-pose."""
+        q = self.body.model.qpos0.copy()
+        q[:3] = self.calibration.root_pos
+        q[3:7] = self.calibration.roles.heading
+        return q
+
+    def t_pose_positions(self) -> np.ndarray:
+        """``(J, 3)`` world joint positions of the avatar's walk-in T-pose."""
+        rest = self.body.skeleton.rest_positions()
+        return self.calibration.root_pos + quat.rotate(self.calibration.roles.heading, rest)
+
+    # -- Synthesizer ------------------------------------------------------------------------
+    @property
+    def skeleton(self) -> Skeleton:
+        return self.body.skeleton
+
+    def settings(self) -> dict:
+        return {"offsets": self.offsets, "scale": self.calibration.scale}
+
+    def reset_state(self) -> None:
+        self._q = self.t_pose()
+        self._solved = False
+        self._last_pos = np.full((len(FULL_BODY), 3), np.nan)
+        self._last_rot = np.tile(quat.IDENTITY, (len(FULL_BODY), 1))
+        self.palm_distance: list[np.ndarray] = []
+        """Per frame so far, ``(2,)`` metres from each palm's controller point to the tracked
+        controller (:func:`~synthesis.avatargo.hands.palm_distance`)."""
+        self.attached: list[np.ndarray] = []
+        """Per frame so far, ``(2,)`` whether the controller was out of the arm's reach and
+        the virtual controller drawn in the hand (:func:`~synthesis.avatargo.hands.
+        out_of_reach`)."""
+        if self.finger_ik is not None:
+            self.finger_ik.reset()
+
+    def goals(self, positions: np.ndarray, quaternions: np.ndarray):
+        """The IK goals for device poses ``positions (B, 6, 3)``, ``quaternions (B, 6, 4)``
+        in role order: positions ``(B, 7, 3)`` and wxyz orientations ``(B, 7, 4)`` of
+        :data:`SITES` (eqs. 2-4 and the palm offsets)."""
+        cal = self.calibration
+        tracked = [FULL_BODY.index(d) for d in TRACKED]
+        hand = [FULL_BODY.index(d) for d in HANDS]
+        pos, rot = cal.tracked.joint_poses(positions[:, tracked], quaternions[:, tracked])
+        wrist_pos, wrist_rot = cal.hands.joint_poses(positions[:, hand], quaternions[:, hand])
+        w = positions[:, FULL_BODY.index("hmd")] - positions[:, FULL_BODY.index("back_tracker")]
+        neck = pos[:, 3] + quat.rotate(spine_bend(cal.w0, w), cal.spine0)
+        goal_pos = np.concatenate([pos, neck[:, None], wrist_pos], axis=1)
+        goal_rot = np.concatenate([rot, rot[:, 3:], wrist_rot], axis=1)
+        return goal_pos, goal_rot
+
+    def advance(self, frames: FrameBatch) -> Poses:
+        """Goals for the whole batch at once, then one warm-started IK solve per frame."""
+        index = self.device_index(frames)
+        ok = frames.usable()[:, index]
+        pos = _first_usable(frames.positions[:, index], ok, self._last_pos)
+        rot = _first_usable(frames.quaternions[:, index], ok, self._last_rot)
+        self._last_pos, self._last_rot = pos[-1], rot[-1]
+        seen = np.isfinite(pos).all(-1).all(-1)  # every device tracked at least once
+        goal_pos, goal_rot = self.goals(np.nan_to_num(pos), quat.normalize(rot))
+        qpos = np.empty((frames.size, self.body.model.nq))
+        fingers = []
+        data = self.ik.configuration.data
+        hand = [FULL_BODY.index(d) for d in HANDS]
+        for b in range(frames.size):
+            if seen[b]:
+                start, steps = self._q, self.iterations_per_tick
+                if not self._solved:  # the first goals may be far from the walk-in T-pose
+                    start, steps = self.ik.fitted_root(goal_pos[b]), FIRST_ITERATIONS
+                self._solved = True
+                self._q, _, _ = self.ik.solve_frame(goal_pos[b], start, goal_rot[b], steps)
+                wrist = data.site_xpos[self._wrist_sites]
+                wrist_rot = quat.from_matrix(data.site_xmat[self._wrist_sites].reshape(2, 3, 3))
+                self.palm_distance.append(palm_distance(wrist, wrist_rot, pos[b, hand], self.grip))
+                shoulders = data.site_xpos[self._shoulder_sites]
+                self.attached.append(out_of_reach(shoulders, goal_pos[b, 5:], self._arm_length))
+            qpos[b] = self._q
+            if self.finger_ik is not None:
+                fingers.append(self.finger_ik.advance().copy())
+        motion = motion_from_qpos(self.body, qpos, DEFAULT_RATE_HZ)
+        local = motion.local_rot
+        if self.finger_ik is not None:
+            local = local.copy()
+            rig = self.finger_ik.rig
+            local[:, rig.joints] = self.finger_ik.local_rotations(np.stack(fingers))
+        return Poses(motion.root_pos, local)
+
+    def run(self, stream: TrackingStream) -> Motion:
+        # The QPs are small: BLAS threads cost more than they save (see avatar_models.body.ik).
+        with threadpool_limits(1, user_api="blas"):
+            return super().run(stream)

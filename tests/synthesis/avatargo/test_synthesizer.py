@@ -1,0 +1,50 @@
+"""The AvatarGo synthesiser: registered under its names, needs the walk-in sample, streams
+what it batches, holds lost devices without NaN, and rejects unknown offset kinds."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from avatar_models.generator import generate
+from avatar_models.generator.subject import Subject
+from synthesis.avatargo import AvatarGo
+from synthesis.avatargo.study import sample_user, setup_for, walk_in
+from synthesis.base import SynthesisError, TrackingFrame
+from synthesis.methods import MethodInputs, build
+
+
+@pytest.fixture(scope="module")
+def session():
+    truth = generate("wave", Subject(), 0.25, 90.0, 0)
+    user = sample_user(5, truth.skeleton)
+    setup = setup_for(user)
+    sample = walk_in(setup, truth.skeleton, user.seed, user.heading_rad)
+    return truth, sample, setup.sample(truth, seed=user.seed)
+
+
+def test_registered_and_needs_the_walk_in(session):
+    truth, sample, stream = session
+    inputs = MethodInputs(lambda: None, 1.75, truth.skeleton)
+    with pytest.raises(SynthesisError, match=r"\[devices\] trackers = true"):
+        build("avatargo", inputs)
+    inputs.walk_in = sample
+    for name, offsets in (("avatargo", "exact"), ("avatargo-fixed", "fixed")):
+        synth = build(name, inputs)
+        assert synth.name == name and synth.offsets == offsets
+    with pytest.raises(SynthesisError, match="offsets must be"):
+        AvatarGo(truth.skeleton, sample, offsets="magic")
+
+
+def test_step_is_run_and_lost_devices_hold(session):
+    truth, sample, stream = session
+    synth = AvatarGo(truth.skeleton, sample)
+    lost = stream.valid.copy()
+    lost[10:20, 0] = False  # the headset drops out for 10 ticks
+    stream = stream.replace(valid=lost, positions=np.where(lost[..., None], stream.positions, 0))
+    batch = synth.run(stream)
+    synth.reset()
+    steps = [synth.step(TrackingFrame.from_stream(stream, i)) for i in range(stream.n_samples)]
+    np.testing.assert_allclose(np.stack([p.root_pos for p in steps]), batch.root_pos, atol=1e-9)
+    np.testing.assert_allclose(np.stack([p.local_rot for p in steps]), batch.local_rot, atol=1e-9)
+    assert np.isfinite(batch.local_rot).all() and np.isfinite(batch.root_pos).all()
