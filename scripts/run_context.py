@@ -9,6 +9,7 @@ from typing import Any
 from rich.console import Console
 
 from avatar_models.motion import Motion
+from render_cams.kinect import KinectSkeletonStream
 from render_cams.tracking import TrackingStream
 from scripts.results import ThresholdResult
 from scripts.scenario import Scenario
@@ -24,6 +25,8 @@ class RunContext:
         humanoid: its body, built once (stage ``body``) and used by every later stage.
         vr_stream: the simulated VR tracking stream (stage ``devices``; None without
             ``[devices] vr``), the synthesisers' input.
+        kinect_stream: the Kinect skeleton stream (stage ``devices``; None without
+            ``[devices] kinect``), MoveBox's input.
         synthesised: each method's output on the humanoid, by method name (stage
             ``synthesis``; empty without ``[synthesis]``).
         metrics: thresholded by ``[thresholds]``.
@@ -38,6 +41,7 @@ class RunContext:
     motion: Motion | None = None
     humanoid: Humanoid | None = None
     vr_stream: TrackingStream | None = None
+    kinect_stream: KinectSkeletonStream | None = None
     synthesised: dict[str, Humanoid] = field(default_factory=dict)
     metrics: dict[str, float] = field(default_factory=dict)
     checks: list[ThresholdResult] = field(default_factory=list)

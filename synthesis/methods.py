@@ -17,10 +17,15 @@ from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 from avatar_models import Skeleton
+from avatar_models.rigs import load_rig
+from render_cams.kinect import KinectSkeletonStream
 from render_cams.vr import Attachment
 from synthesis.base import SynthesisError, Synthesizer
 from synthesis.coolmoves import CoolMoves, Database, Options
 from synthesis.ik_baseline import IKBaseline
+from synthesis.movebox import MoveBox
+from synthesis.movebox.mapping import PELVIS
+from synthesis.movebox.resize import resized
 
 
 @dataclass(eq=False)
@@ -39,6 +44,8 @@ class MethodInputs:
             position only (the rigs' hand frames differ).
         coolmoves: option overrides for every CoolMoves variant (e.g. a scenario's
             ``foot_contact``), applied on top of the variant's own.
+        kinect: the Kinect skeleton stream of the same take (``[devices] kinect``), for
+            MoveBox; None where no Kinect was recorded.
     """
 
     database_factory: Callable[[], Database]
@@ -46,6 +53,7 @@ class MethodInputs:
     rig: Skeleton
     calibration: Sequence[Attachment] | None = None
     coolmoves: dict = field(default_factory=dict)
+    kinect: KinectSkeletonStream | None = None
 
     @cached_property
     def database(self) -> Database:
@@ -83,6 +91,24 @@ def ik_baseline(inputs: MethodInputs) -> Synthesizer:
     return IKBaseline(inputs.rig, inputs.user_height_m, inputs.calibration, own)
 
 
+def movebox(inputs: MethodInputs) -> Synthesizer:
+    """MoveBox on the inputs' Kinect stream (:class:`~synthesis.movebox.MoveBox`), driving the
+    scored rig when it is an avatar rig, else the avatar rig resized to the user.
+
+    Raises:
+        SynthesisError: no Kinect stream (the message says which ``[devices]`` entry to set).
+    """
+    if inputs.kinect is None:
+        raise SynthesisError(
+            'movebox reads the Kinect skeleton stream: set [devices] kinect = "kinect-v2" '
+            '(or "azure-kinect") in the scenario'
+        )
+    target = inputs.rig
+    if PELVIS not in target:
+        target = resized(load_rig("avatar").skeleton, inputs.user_height_m)
+    return MoveBox(inputs.kinect, target)
+
+
 METHODS: dict[str, Method] = {
     m.name: m
     for m in (
@@ -101,9 +127,14 @@ METHODS: dict[str, Method] = {
             Options(align_about_centroid=True),
         ),
         Method("ik", "VRIK-like full-body IK from headset and controllers (§4.1.1)", ik_baseline),
+        Method(
+            "movebox",
+            "MoveBox: the Kinect skeleton retargeted onto the avatar (§III-A1; [devices] kinect)",
+            movebox,
+        ),
     )
 }
-"""Every registered method by name (AvatarGo, MoveBox and ControllerPose join as they land)."""
+"""Every registered method by name (AvatarGo and ControllerPose join as they land)."""
 
 
 def method(name: str) -> Method:

@@ -1,0 +1,62 @@
+"""Avatar resizing to the user (MoveBox §III-B4): "the resizing feature takes the three
+dimensional positions of the user's foot and head bones, which are captured by the Azure
+Kinect or Kinect v2 camera, to measure the user's height. The Rocketbox avatar is then
+resized, by its scale component, to match the user's height."
+
+The Kinect head and foot joints are not the head top and the sole: the measured head-to-foot
+height is scaled by the avatar's own stature over its rest head-to-foot joint height (the
+body17 head and foot joints, where the Kinect rigs put theirs).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from avatar_models import Skeleton
+from avatar_models.measure import standing_height
+from avatar_models.rigs import identify_rig, load_rig
+from render_cams.kinect import KinectSkeletonStream, TrackingState
+from synthesis.base import SynthesisError
+
+UPRIGHT_PERCENTILE = 90.0
+"""The user stands upright in the upper frames of head-over-feet height (crouching, leaning
+and walking only lower it); a high percentile, not the maximum, ignores noise spikes."""
+
+
+def head_to_foot_m(kinect: KinectSkeletonStream) -> np.ndarray:
+    """``(N,)`` head-joint height over the lower foot joint, in frames where the head and both
+    feet are Tracked (NaN elsewhere)."""
+    rig = load_rig(kinect.rig)
+    names = kinect.joint_names
+    head = names.index(rig.body17["head"])
+    feet = [names.index(rig.body17[f]) for f in ("l_foot", "r_foot")]
+    tracked = (kinect.states[:, [head, *feet]] == TrackingState.TRACKED).all(axis=1)
+    z = kinect.positions[..., 2]
+    height = z[:, head] - z[:, feet].min(axis=1)
+    return np.where(tracked, height, np.nan)
+
+
+def user_height_m(kinect: KinectSkeletonStream, avatar: Skeleton) -> float:
+    """The user's standing height measured from the stream, in ``avatar``'s stature terms.
+
+    Raises:
+        SynthesisError: no frame has the head and both feet Tracked.
+    """
+    heights = head_to_foot_m(kinect)
+    if not np.isfinite(heights).any():
+        raise SynthesisError(
+            f"cannot measure the user's height: no {kinect.rig} frame tracks the head and "
+            "both feet (stand in full view of the sensor)"
+        )
+    rig = identify_rig(avatar)
+    rest_z = avatar.rest_positions()[:, 2]
+    head, foot = (avatar.index(rig.body17[b]) for b in ("head", "l_foot"))
+    ratio = standing_height(avatar) / (rest_z[head] - rest_z[foot])
+    return float(np.nanpercentile(heights, UPRIGHT_PERCENTILE) * ratio)
+
+
+def resized(avatar: Skeleton, height_m: float) -> Skeleton:
+    """``avatar`` scaled uniformly (its scale component) to stand ``height_m`` tall."""
+    if not (np.isfinite(height_m) and height_m > 0):
+        raise SynthesisError(f"an avatar height must be positive, got {height_m!r}")
+    return avatar.scaled(height_m / standing_height(avatar))
