@@ -45,7 +45,7 @@ from synthesis.movebox import MoveBox
 from synthesis.movebox.face import lip_sync, read_wav
 from synthesis.movebox.mapping import mapping_for
 from synthesis.movebox.resize import resized, user_height_m
-from synthesis.movebox.retarget import Retargeting, twist_angle
+from synthesis.movebox.retarget import ROLLS, Retargeting, twist_angle
 from synthesis.movebox.similarity import loop_points, seam_index
 
 SENSORS = ("kinect-v2", "azure-kinect")
@@ -167,15 +167,14 @@ def evaluate_sensor(
     row = {
         "tracked_frames_frac": float(tracked.mean()),
         "retarget_err_cm": {
-            "noise_free": body17_err_cm(retargeted(clean, target, "rest"), truth30, tracked),
-            "noisy": body17_err_cm(retargeted(noisy, target, "rest"), truth30, tracked),
+            "noise_free": body17_err_cm(retargeted(clean, target, "hinge"), truth30, tracked),
+            "noisy": body17_err_cm(retargeted(noisy, target, "hinge"), truth30, tracked),
             "kinect_err_cm": kinect_err_cm(noisy, truth30, tracked),
         },
     }
     if take.own_avatar:
         row["roll_err_deg"] = {
-            roll: roll_err_deg(retargeted(clean, target, roll), truth30, tracked)
-            for roll in ("rest", "sensor")
+            roll: roll_err_deg(retargeted(clean, target, roll), truth30, tracked) for roll in ROLLS
         }
     stream = VRSetup().sample(truth, seed=seed)
     raw = MoveBox(noisy, target, tau_s=0.0).run(stream)

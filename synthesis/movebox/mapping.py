@@ -15,7 +15,7 @@ keep their rest rotation relative to their parent.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from synthesis.base import SynthesisError
 
@@ -30,6 +30,8 @@ class BoneDrive:
         aim: the Kinect joint the bone points at, or None (orientation only).
         orient: the Kinect joint whose orientation gives the bone's roll.
         orient_rest: the Kinect rest bone (from, to) that ``orient``'s orientation turns.
+        bend: for a bone whose child is a hinge (elbow, knee), the direction the child's far
+            end moves when the hinge flexes, in this bone's rest frame; else None.
     """
 
     joint: str
@@ -37,6 +39,7 @@ class BoneDrive:
     aim: str | None
     orient: str
     orient_rest: tuple[str, str]
+    bend: tuple[float, float, float] | None = None
 
     @property
     def kinect_joints(self) -> tuple[str, ...]:
@@ -78,6 +81,13 @@ def _azure_drive(joint: str, child: str, start: str, end: str | None, rest_end: 
     return BoneDrive(joint, child, end, start, (start, rest_end))
 
 
+ELBOW_BEND = (1.0, 0.0, 0.0)
+KNEE_BEND = (-1.0, 0.0, 0.0)
+"""Where the forearm and the calf swing when the elbow and knee flex, in the upper arm's and
+thigh's rest frames: the avatar rig's flexion limits (avatar.toml: elbows flex about z
+towards +x, forwards; knees about y towards -x, backwards)."""
+
+
 def _limbs(side: str, names: dict[str, str], drive) -> tuple[BoneDrive, ...]:
     """Clavicle, arm, hand and leg drives of one side ``"L"``/``"R"``; ``names`` maps
     clavicle/shoulder/elbow/wrist/hand/hip/knee/ankle/foot to Kinect joints."""
@@ -85,10 +95,10 @@ def _limbs(side: str, names: dict[str, str], drive) -> tuple[BoneDrive, ...]:
     n = names
     return (
         drive(b + "Clavicle", b + "UpperArm", n["clavicle"], n["shoulder"]),
-        drive(b + "UpperArm", b + "Forearm", n["shoulder"], n["elbow"]),
+        replace(drive(b + "UpperArm", b + "Forearm", n["shoulder"], n["elbow"]), bend=ELBOW_BEND),
         drive(b + "Forearm", b + "Hand", n["elbow"], n["wrist"]),
         drive(b + "Hand", b + "Finger2", n["wrist"], n["hand"]),
-        drive(b + "Thigh", b + "Calf", n["hip"], n["knee"]),
+        replace(drive(b + "Thigh", b + "Calf", n["hip"], n["knee"]), bend=KNEE_BEND),
         drive(b + "Calf", b + "Foot", n["knee"], n["ankle"]),
         drive(b + "Foot", b + "Toe0", n["ankle"], n["foot"]),
     )

@@ -12,7 +12,10 @@ q_absolute), gives it back. The absolute rotation of a bone:
    avatar's rest roll (``roll="rest"``: the parent's absolute rotation, i.e. no twist of
    the bone relative to its parent). Kinect V2 has no consistent roll (§IV-B1); MoveBox
    "default[s] the orientation of the joints around themselves to that on the original
-   avatar", which is ``"rest"``.
+   avatar", which is ``"rest"``. ``"hinge"`` (beyond the paper) keeps the rest roll too,
+   but also keeps the avatar's rest hinge axes of the elbows and knees: the upper arm and
+   thigh take the roll that makes the measured bend of the forearm or calf a flexion of
+   the hinge (the roll is then seen, not assumed, wherever the joint is bent).
 2. its direction: the smallest rotation that turns the bone (from where its parents put its
    start) towards the Kinect joint it aims at, so the avatar's limbs point where the
    user's do whatever the rig proportions.
@@ -32,7 +35,10 @@ import numpy as np
 from avatar_models import Skeleton, quat
 from synthesis.movebox.mapping import PELVIS, PELVIS_TRIAD, BoneDrive, RigMapping
 
-ROLLS = ("rest", "sensor")
+ROLLS = ("hinge", "rest", "sensor")
+BEND_FADE = (0.1, 0.3)
+"""Sine of the hinge bend over which ``"hinge"`` roll fades in: a nearly straight elbow or
+knee has no bend plane (our choice)."""
 
 
 def shortest_arc(u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -82,7 +88,7 @@ class Retargeting:
         kinect_rest: ``(K, 3)`` the Kinect rig's rest joint positions (for the rest
             alignment of sensor orientations).
         kinect_names: the ``K`` Kinect joint names.
-        roll: ``"rest"`` (recover the avatar's rest roll) or ``"sensor"``.
+        roll: ``"hinge"``, ``"rest"`` (recover the avatar's rest roll) or ``"sensor"``.
         stabilise_wrists: hands follow the forearm (§IV-B2).
     """
 
@@ -90,7 +96,7 @@ class Retargeting:
     mapping: RigMapping
     kinect_rest: np.ndarray
     kinect_names: tuple[str, ...]
-    roll: str = "rest"
+    roll: str = "hinge"
     stabilise_wrists: bool = True
 
     def drives(self) -> list[BoneDrive]:
@@ -166,4 +172,24 @@ class Retargeting:
             return world
         bone = self.target.offsets[self.target.index(drive.child)]
         target = positions[:, self.kinect_index(drive.aim)] - start
-        return quat.mul(shortest_arc(quat.rotate(world, bone), target), world)
+        world = quat.mul(shortest_arc(quat.rotate(world, bone), target), world)
+        if self.roll == "hinge" and drive.bend is not None:
+            world = self._hinge_roll(
+                drive, world, positions[:, self.kinect_index(drive.aim)], positions
+            )
+        return world
+
+    def _hinge_roll(self, drive, world, end, positions) -> np.ndarray:
+        """``world (N, 4)`` twisted about the bone so that its child's measured direction
+        bends towards ``drive.bend`` (module docstring), faded in with the bend."""
+        child = next(d for d in self.mapping.drives if d.joint == drive.child)
+        axis = self.target.offsets[self.target.index(drive.child)]
+        axis = axis / np.linalg.norm(axis)
+        seen = quat.rotate(quat.conj(world), positions[:, self.kinect_index(child.aim)] - end)
+        seen_perp = seen - np.sum(seen * axis, -1, keepdims=True) * axis
+        bend = np.asarray(drive.bend) - np.dot(drive.bend, axis) * axis
+        angle = np.arctan2(np.cross(bend, seen_perp) @ axis, seen_perp @ bend)
+        sine = np.linalg.norm(seen_perp, axis=-1) / np.maximum(np.linalg.norm(seen, axis=-1), 1e-12)
+        lo, hi = BEND_FADE
+        weight = np.clip((sine - lo) / (hi - lo), 0.0, 1.0)
+        return quat.mul(world, quat.from_axis_angle(axis, weight * angle))

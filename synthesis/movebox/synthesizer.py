@@ -24,8 +24,9 @@ from synthesis.movebox.mapping import PELVIS, mapping_for
 from synthesis.movebox.retarget import ROLLS, Retargeting
 from synthesis.movebox.smoothing import TIME_CONSTANT_S, ExponentialSmoother, smoothing_alpha
 
-DEFAULT_ROLL = {"kinect_v2": "rest", "azure_kinect": "sensor"}
-"""Roll per sensor: V2 has none of its own (§IV-B1), Azure's is better (§IV-B1)."""
+DEFAULT_ROLL = {"kinect_v2": "hinge", "azure_kinect": "sensor"}
+"""Roll per sensor: V2 has none of its own (§IV-B1): the avatar's rest roll with its hinge
+axes (:mod:`.retarget`); Azure's own is better (§IV-B1)."""
 
 
 def check_stream(kinect: KinectSkeletonStream) -> None:
@@ -48,7 +49,7 @@ class MoveBox(Synthesizer):
     Args:
         kinect: the skeleton stream (``kinect_v2`` or ``azure_kinect`` rig).
         target: the avatar skeleton to drive (the avatar rig's joints, any proportions).
-        roll: ``"rest"``, ``"sensor"`` or ``"auto"`` (:data:`DEFAULT_ROLL`).
+        roll: ``"hinge"``, ``"rest"``, ``"sensor"`` or ``"auto"`` (:data:`DEFAULT_ROLL`).
         stabilise_wrists: hands follow the forearm (§IV-B2).
         tau_s: smoothing time constant (0: none).
 
