@@ -18,6 +18,7 @@ BENCHMARKS: dict[str, str] = {
     "coolmoves": "coolmoves",
     "cameras": "cameras",
     "kinect": "kinect",
+    "movebox": "movebox",
     "control": "control",
     "suite": "suite",
 }

@@ -33,12 +33,28 @@ from dataclasses import dataclass
 import numpy as np
 
 from avatar_models import Skeleton, quat
+from synthesis.base import SynthesisError
 from synthesis.movebox.mapping import PELVIS, PELVIS_TRIAD, BoneDrive, RigMapping
 
 ROLLS = ("hinge", "rest", "sensor")
 BEND_FADE = (0.1, 0.3)
 """Sine of the hinge bend over which ``"hinge"`` roll fades in: a nearly straight elbow or
 knee has no bend plane (our choice)."""
+
+
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a x b`` over ``(..., 3)``, written out: ``np.cross`` moves axes on every call, which
+    dominated a streaming step (one Kinect frame, ~40 small crosses)."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+
+
+def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Unit quaternions ``q (..., 4)`` applied to ``v (..., 3)`` (or one ``(3,)``), through
+    :func:`avatar_models.quat.unit_to_matrix` (no cross products)."""
+    return (quat.unit_to_matrix(q) @ np.asarray(v, float)[..., None])[..., 0]
 
 
 def shortest_arc(u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -52,9 +68,9 @@ def shortest_arc(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     u = u / np.maximum(nu, 1e-12)
     v = v / np.maximum(nv, 1e-12)
     w = 1.0 + np.sum(u * v, axis=-1)
-    axis = np.cross(u, v)
+    axis = cross(u, v)
     opposite = w < 1e-9
-    perpendicular = np.cross(u, np.where(np.abs(u[..., :1]) < 0.9, [1.0, 0, 0], [0, 1.0, 0]))
+    perpendicular = cross(u, np.where(np.abs(u[..., :1]) < 0.9, [1.0, 0, 0], [0, 1.0, 0]))
     axis = np.where(opposite[..., None], perpendicular, axis)
     q = np.concatenate([np.where(opposite, 0.0, w)[..., None], axis], axis=-1)
     q = np.where(degenerate[..., None], quat.IDENTITY, q)
@@ -66,9 +82,9 @@ def frame_from_pair(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     ``a + b``, z along ``a x b``."""
     x = a + b
     x = x / np.maximum(np.linalg.norm(x, axis=-1, keepdims=True), 1e-12)
-    z = np.cross(a, b)
+    z = cross(a, b)
     z = z / np.maximum(np.linalg.norm(z, axis=-1, keepdims=True), 1e-12)
-    return np.stack([x, np.cross(z, x), z], axis=-1)
+    return np.stack([x, cross(z, x), z], axis=-1)
 
 
 def twist_angle(q: np.ndarray, axis: np.ndarray) -> np.ndarray:
@@ -115,6 +131,18 @@ class Retargeting:
             self.kinect_rest[b] - self.kinect_rest[a],
         )
 
+    def check_chains(self) -> None:
+        """Every driven joint's ancestors are driven or the root (what ``__call__`` needs).
+
+        Raises:
+            SynthesisError: a mapping that leaves a gap in a driven chain.
+        """
+        sk = self.target
+        driven = {sk.index(d.joint) for d in self.drives()} | {sk.index(PELVIS), 0}
+        gaps = [sk.names[j] for j in driven if sk.parents[j] >= 0 and sk.parents[j] not in driven]
+        if gaps:
+            raise SynthesisError(f"driven avatar joints below undriven ones: {gaps}")
+
     def joint_sources(self) -> list[tuple[int, ...]]:
         """Per avatar joint, the Kinect joint indices its rotation reads (empty: undriven)."""
         out: list[tuple[int, ...]] = [()] * self.target.n_joints
@@ -136,19 +164,21 @@ class Retargeting:
         pos[:, 0] = positions[:, self.kinect_index(self.mapping.root)]
         drives = {sk.index(d.joint): d for d in self.drives()}
         pelvis = sk.index(PELVIS)
-        for j in range(1, sk.n_joints):
+        driven = sorted({*drives, pelvis})
+        local = np.tile(quat.IDENTITY, (n, sk.n_joints, 1))
+        # Undriven joints keep their rest local rotation, so only the driven ones (and their
+        # ancestors, all driven or the root) need an absolute rotation and a position.
+        for j in driven:
             parent = sk.parents[j]
-            pos[:, j] = pos[:, parent] + quat.rotate(world[:, parent], sk.offsets[j])
+            pos[:, j] = pos[:, parent] + rotate(world[:, parent], sk.offsets[j])
             if j == pelvis:
                 world[:, j] = self._pelvis(positions)
-            elif j in drives:
+            else:
                 world[:, j] = self._bone(
                     drives[j], world[:, parent], pos[:, j], positions, orientations
                 )
-            else:
-                world[:, j] = world[:, parent]
-        local = quat.mul(quat.conj(world[:, sk.parents[1:]]), world[:, 1:])
-        return pos[:, 0], np.concatenate([world[:, :1], local], axis=1)
+            local[:, j] = quat.mul(quat.conj(world[:, parent]), world[:, j])
+        return pos[:, 0], local
 
     def _pelvis(self, positions: np.ndarray) -> np.ndarray:
         """``(N, 4)``: the rotation taking the avatar's rest pelvis-to-hip vectors onto the
@@ -172,7 +202,7 @@ class Retargeting:
             return world
         bone = self.target.offsets[self.target.index(drive.child)]
         target = positions[:, self.kinect_index(drive.aim)] - start
-        world = quat.mul(shortest_arc(quat.rotate(world, bone), target), world)
+        world = quat.mul(shortest_arc(rotate(world, bone), target), world)
         if self.roll == "hinge" and drive.bend is not None:
             world = self._hinge_roll(
                 drive, world, positions[:, self.kinect_index(drive.aim)], positions
@@ -185,10 +215,10 @@ class Retargeting:
         child = next(d for d in self.mapping.drives if d.joint == drive.child)
         axis = self.target.offsets[self.target.index(drive.child)]
         axis = axis / np.linalg.norm(axis)
-        seen = quat.rotate(quat.conj(world), positions[:, self.kinect_index(child.aim)] - end)
+        seen = rotate(quat.conj(world), positions[:, self.kinect_index(child.aim)] - end)
         seen_perp = seen - np.sum(seen * axis, -1, keepdims=True) * axis
         bend = np.asarray(drive.bend) - np.dot(drive.bend, axis) * axis
-        angle = np.arctan2(np.cross(bend, seen_perp) @ axis, seen_perp @ bend)
+        angle = np.arctan2(cross(bend, seen_perp) @ axis, seen_perp @ bend)
         sine = np.linalg.norm(seen_perp, axis=-1) / np.maximum(np.linalg.norm(seen, axis=-1), 1e-12)
         lo, hi = BEND_FADE
         weight = np.clip((sine - lo) / (hi - lo), 0.0, 1.0)

@@ -85,6 +85,7 @@ class MoveBox(Synthesizer):
             roll,
             stabilise_wrists,
         )
+        self.retargeting.check_chains()
         self._sources = self.retargeting.joint_sources()
         self._root_joint = kinect.joint_names.index(mapping.root)
         self.tau_s = float(tau_s)
@@ -134,13 +135,16 @@ class MoveBox(Synthesizer):
         latest = np.nanmax(ticks) if np.isfinite(ticks).any() else -np.inf
         available = int(np.searchsorted(self.kinect.timestamps, latest, side="right"))
         start = self._consumed
-        root, local = self.kinect_frames(start, max(available, start))
+        if available > start:
+            root, local = self.kinect_frames(start, available)
+        else:  # no new Kinect frame: nothing to retarget
+            root, local = self._last_root[:0], self._last_rot[:0]
         # Each tick shows the latest Kinect frame at or before it (index -1: none yet).
         seen = np.searchsorted(self.kinect.timestamps, np.nan_to_num(ticks, nan=-np.inf), "right")
         row = np.clip(seen - start, 0, None)  # 0: the last frame before this batch
         roots = np.concatenate([self._last_root, root])[row]
         rots = np.concatenate([self._last_rot, local])[row]
         if local.shape[0]:
-            self._consumed = max(available, start)
+            self._consumed = available
             self._last_root, self._last_rot = root[-1:], local[-1:]
         return Poses(self._smoother("root", roots, False), self._smoother("rot", rots, True))
