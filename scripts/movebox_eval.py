@@ -20,7 +20,7 @@ Azure Kinect):
 
 Real clips are driven onto the avatar resized to the user from the Kinect's head and foot
 joints (§III-B4); built-in takes onto the subject's own avatar rig. ``lip_sync`` (with
-``--audio DIR``) correlates the jaw with each WAV's RMS envelope.
+``--audio``) correlates the jaw with each WAV's RMS envelope.
 """
 
 from __future__ import annotations
@@ -35,14 +35,19 @@ from avatar_models.formats import load_motion
 from avatar_models.generator import generate
 from avatar_models.rigs import body17_positions, load_rig
 from render_cams.device import motion_at_rate
-from render_cams.kinect import KinectSkeletonStream, TrackingState, kinect_skeleton
+from render_cams.kinect import (
+    KinectSkeletonStream,
+    TrackingState,
+    kinect_skeleton,
+    read_kinect_skeleton,
+)
 from render_cams.vr import VRSetup
 from scripts.method_score import score_method
 from sim.humanoid import Humanoid, humanoid_for
 from sim.thresholds import CheckConfig
 from synthesis.base import SynthesisError
-from synthesis.movebox import MoveBox
-from synthesis.movebox.face import lip_sync, read_wav
+from synthesis.movebox import MoveBox, check_stream
+from synthesis.movebox.face import AudioFormatError, lip_sync, read_wav
 from synthesis.movebox.mapping import mapping_for
 from synthesis.movebox.resize import resized, user_height_m
 from synthesis.movebox.retarget import ROLLS, Retargeting, twist_angle
@@ -196,10 +201,10 @@ def evaluate_sensor(
     return row
 
 
-def lip_sync_scores(audio_dir: Path) -> dict:
-    """Per WAV in ``audio_dir``: Pearson r of the jaw opening with the 10 ms RMS envelope."""
+def lip_sync_scores(files: list[Path]) -> dict:
+    """Per WAV file: Pearson r of the jaw opening with the 10 ms RMS envelope."""
     out = {}
-    for path in sorted(audio_dir.glob("*.wav")):
+    for path in files:
         rate, samples = read_wav(path)
         sync = lip_sync(samples, rate, 30.0)
         out[path.name] = {"r_jaw_rms": envelope_correlation(sync.jaw, samples, rate, 30.0)}
@@ -219,7 +224,7 @@ def run_movebox_eval(
     takes: list[Take],
     sensors=SENSORS,
     seed: int = 0,
-    audio_dir: Path | None = None,
+    audio: list[Path] = (),
     progress=None,
 ) -> dict:
     """``{"takes": {label: {sensor: row}}, "summary": {sensor: means}, "lip_sync": ...}``."""
@@ -231,8 +236,8 @@ def run_movebox_eval(
         if progress is not None:
             progress(i + 1, len(takes), take.label)
     out = {"takes": rows, "summary": summarise(rows, sensors), "seed": seed}
-    if audio_dir is not None:
-        out["lip_sync"] = lip_sync_scores(audio_dir)
+    if audio:
+        out["lip_sync"] = lip_sync_scores(list(audio))
     return out
 
 
@@ -255,3 +260,31 @@ def _mean_tree(rows: list[dict]):
         keys = [k for k in first if all(k in r for r in rows) and not isinstance(first[k], list)]
         return {k: _mean_tree([r[k] for r in rows]) for k in keys}
     return float(np.mean(rows))
+
+
+def audio_files(path: Path) -> list[Path]:
+    """The WAV files ``path`` names (a file, or every ``*.wav`` of a folder), each checked
+    readable now, before any long work.
+
+    Raises:
+        AudioFormatError: a missing path, a folder without WAV files, an unreadable file.
+    """
+    files = sorted(path.glob("*.wav")) if path.is_dir() else [path]
+    if not files:
+        raise AudioFormatError(f"{path}: no .wav file in this folder")
+    for file in files:
+        read_wav(file)
+    return files
+
+
+def recorded_take(folder: Path) -> MoveBox:
+    """MoveBox on a recorded Kinect take (:func:`~render_cams.kinect.read_kinect_skeleton`),
+    driving the avatar resized to the performer (§III-B4); checked before any long work.
+
+    Raises:
+        KinectError: not a recording. SynthesisError: an empty or never-tracked stream.
+    """
+    kinect = read_kinect_skeleton(folder)
+    check_stream(kinect)
+    avatar = load_rig("avatar").skeleton
+    return MoveBox(kinect, resized(avatar, user_height_m(kinect, avatar)))

@@ -18,7 +18,6 @@ from avatar_models.fileio import write_atomic
 from avatar_models.generator import Subject, generate
 from avatar_models.rigs import load_rig
 from render_cams.kinect import kinect_skeleton
-from render_cams.vr import VRSetup
 from synthesis.movebox import MoveBox
 from synthesis.movebox.face import lip_sync, read_wav
 from synthesis.movebox.recording import playback
@@ -43,8 +42,7 @@ def record_take(activity: str, height_m: float, seconds: float, seed: int) -> Mo
     performer = generate(activity, Subject(height_m=height_m), seconds, 90.0, seed)
     kinect = kinect_skeleton(performer, "kinect-v2", seed=seed)
     avatar = resized(load_rig("avatar").skeleton, height_m)
-    clock = VRSetup().sample(performer, seed=seed)
-    return MoveBox(kinect, avatar).run(clock).resample(30.0)
+    return MoveBox(kinect, avatar).record(30.0)
 
 
 def cast(seconds: float, seed: int, audio: Path | None) -> list[Actor]:

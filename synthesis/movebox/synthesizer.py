@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import Skeleton, quat
+from avatar_models import Motion, Skeleton, quat
 from avatar_models.rigs import load_rig
 from render_cams.kinect import KinectSkeletonStream, TrackingState
 from synthesis.base import DEFAULT_RATE_HZ, FrameBatch, Poses, SynthesisError, Synthesizer
@@ -148,3 +148,17 @@ class MoveBox(Synthesizer):
             self._consumed = available
             self._last_root, self._last_rot = root[-1:], local[-1:]
         return Poses(self._smoother("root", roots, False), self._smoother("rot", rots, True))
+
+    def record(self, rate_hz: float = DEFAULT_RATE_HZ) -> Motion:
+        """The whole Kinect stream as an animation (MoveBox's recording, §III-B1): a fresh
+        session advanced on the 90 Hz display clock from the first Kinect frame to the last,
+        without a VR stream, then resampled to ``rate_hz``."""
+        stamps = self.kinect.timestamps
+        n = int(np.floor((stamps[-1] - stamps[0]) * DEFAULT_RATE_HZ)) + 1
+        ticks = stamps[0] + np.arange(n) / DEFAULT_RATE_HZ
+        self.reset()
+        batch = FrameBatch(ticks, (), np.empty((n, 0, 3)), np.empty((n, 0, 4)), np.empty((n, 0)))
+        poses = self.advance(batch)
+        meta = {"method": self.name, **self.settings(), "kinect": self.kinect.meta}
+        motion = Motion(self.skeleton, DEFAULT_RATE_HZ, poses.root_pos, poses.local_rot, meta=meta)
+        return motion if rate_hz == DEFAULT_RATE_HZ else motion.resample(rate_hz)
