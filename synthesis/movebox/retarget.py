@@ -78,12 +78,16 @@ def shortest_arc(u: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 
 def frame_from_pair(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``(..., 3, 3)`` orthonormal frames from two non-parallel vectors ``(..., 3)``: x along
-    ``a + b``, z along ``a x b``."""
+    """``(..., 3, 3)`` orthonormal frames from two vectors ``(..., 3)``: x along ``a + b``,
+    z along ``a x b``; the identity where they are (near) parallel or zero (a garbage frame
+    must not stop the stream)."""
     x = a + b
-    x = x / np.maximum(np.linalg.norm(x, axis=-1, keepdims=True), 1e-12)
     z = cross(a, b)
-    z = z / np.maximum(np.linalg.norm(z, axis=-1, keepdims=True), 1e-12)
+    nx = np.linalg.norm(x, axis=-1, keepdims=True)
+    nz = np.linalg.norm(z, axis=-1, keepdims=True)
+    ok = (nx > 1e-9) & (nz > 1e-9)
+    x = np.where(ok, x / np.maximum(nx, 1e-12), [1.0, 0.0, 0.0])
+    z = np.where(ok, z / np.maximum(nz, 1e-12), [0.0, 0.0, 1.0])
     return np.stack([x, cross(z, x), z], axis=-1)
 
 

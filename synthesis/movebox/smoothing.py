@@ -45,7 +45,8 @@ class ExponentialSmoother:
 
     Attributes:
         alpha: share per tick in ``(0, 1]``.
-        state: the filter's last output per channel (None before the first tick).
+        state: per channel, the filter's last output (and, for rotations, its last
+            sign-aligned input under ``"KEY:input"``); empty before the first tick.
     """
 
     alpha: float
@@ -56,8 +57,9 @@ class ExponentialSmoother:
         if values.shape[0] == 0:
             return values
         last = self.state.get(key)
-        if rotation:
-            values = align_signs(values, last)
+        if rotation:  # each input in the hemisphere of the input before it
+            values = align_signs(values, self.state.get(f"{key}:input"))
+            self.state[f"{key}:input"] = values[-1]
         start = values[0] if last is None else last
         a = self.alpha
         zi = ((1.0 - a) * start)[None]
