@@ -145,16 +145,17 @@ def blinks(
             f"unknown blink activity {activity!r}; known: {list(BLINK_RATES_PER_MIN)}"
         )
     mean_gap = 60.0 / BLINK_RATES_PER_MIN[activity]
-    n = int(np.ceil(duration_s / MIN_BLINK_GAP_S)) + 1
+    n = int(np.ceil(duration_s / MIN_BLINK_GAP_S)) + 2
     # Exponential gaps above the minimum, with the mean gap the cited rate gives.
     gaps = MIN_BLINK_GAP_S + rng.exponential(mean_gap - MIN_BLINK_GAP_S, n)
     onsets = np.cumsum(gaps) - gaps[0] * rng.uniform()
     t = np.arange(int(np.floor(duration_s * fps)) + 1) / fps
-    since = t[:, None] - onsets[None, :]
+    # Blinks never overlap (the minimum gap outlasts one), so each frame sees the last onset.
+    last = np.searchsorted(onsets, t, side="right") - 1
+    since = np.where(last >= 0, t - onsets[np.maximum(last, 0)], np.inf)
     closing = np.clip(since / BLINK_CLOSE_S, 0.0, 1.0)
     opening = np.clip(1.0 - (since - BLINK_CLOSE_S) / BLINK_OPEN_S, 0.0, 1.0)
-    closure = np.where(since < BLINK_CLOSE_S, closing, opening) * (since >= 0)
-    return closure.max(axis=1)
+    return np.where(since < BLINK_CLOSE_S, closing, opening)
 
 
 def face_motion(skeleton: Skeleton, fps: float, jaw: np.ndarray, closure: np.ndarray) -> Motion:

@@ -5,7 +5,9 @@ resized, by its scale component, to match the user's height."
 
 The Kinect head and foot joints are not the head top and the sole: the measured head-to-foot
 height is scaled by the avatar's own stature over its rest head-to-foot joint height (the
-body17 head and foot joints, where the Kinect rigs put theirs).
+body17 head and foot joints, where the Kinect rigs put theirs). Resizing is triggered while
+the user stands (the paper's button): the median over the frames given, which the joint
+noise does not bias (a high percentile read 3 cm tall at 1.58 m and 1.90 m).
 """
 
 from __future__ import annotations
@@ -18,9 +20,6 @@ from avatar_models.rigs import identify_rig, load_rig
 from render_cams.kinect import KinectSkeletonStream, TrackingState
 from synthesis.base import SynthesisError
 
-UPRIGHT_PERCENTILE = 90.0
-"""The user stands upright in the upper frames of head-over-feet height (crouching, leaning
-and walking only lower it); a high percentile, not the maximum, ignores noise spikes."""
 
 
 def head_to_foot_m(kinect: KinectSkeletonStream) -> np.ndarray:
@@ -37,7 +36,8 @@ def head_to_foot_m(kinect: KinectSkeletonStream) -> np.ndarray:
 
 
 def user_height_m(kinect: KinectSkeletonStream, avatar: Skeleton) -> float:
-    """The user's standing height measured from the stream, in ``avatar``'s stature terms.
+    """The user's standing height measured from the stream (the user standing in it), in
+    ``avatar``'s stature terms.
 
     Raises:
         SynthesisError: no frame has the head and both feet Tracked.
@@ -52,7 +52,7 @@ def user_height_m(kinect: KinectSkeletonStream, avatar: Skeleton) -> float:
     rest_z = avatar.rest_positions()[:, 2]
     head, foot = (avatar.index(rig.body17[b]) for b in ("head", "l_foot"))
     ratio = standing_height(avatar) / (rest_z[head] - rest_z[foot])
-    return float(np.nanpercentile(heights, UPRIGHT_PERCENTILE) * ratio)
+    return float(np.nanmedian(heights) * ratio)
 
 
 def resized(avatar: Skeleton, height_m: float) -> Skeleton:
