@@ -41,6 +41,7 @@ from render_cams.kinect import (
     kinect_skeleton,
     read_kinect_skeleton,
 )
+from render_cams.kinect.sensors import KINECT_RATE_HZ
 from render_cams.vr import VRSetup
 from scripts.method_score import score_method
 from sim.humanoid import Humanoid, humanoid_for
@@ -78,7 +79,9 @@ def builtin_takes(activities, duration_s: float, seed: int) -> list[Take]:
 
 def real_takes(folder: Path, per_source: int, duration_s: float) -> list[Take]:
     """The first ``per_source`` BVH clips (sorted) of each folder holding any, cut to
-    ``duration_s``; a folder without BVH clips raises :class:`SynthesisError`."""
+    ``duration_s`` and, when faster, brought to the Kinect's 30 Hz (what the sensor sees, and
+    a quarter of the frames of a 120 Hz CMU clip to put on the humanoid); a folder without
+    BVH clips raises :class:`SynthesisError`."""
     by_folder: dict[Path, list[Path]] = {}
     for path in sorted(folder.rglob("*.bvh")):
         by_folder.setdefault(path.parent, []).append(path)
@@ -89,7 +92,10 @@ def real_takes(folder: Path, per_source: int, duration_s: float) -> list[Take]:
         for path in paths[:per_source]:
             motion = load_motion(path)
             frames = min(motion.n_frames, int(duration_s * motion.fps) + 1)
-            takes.append(Take(str(path.relative_to(folder)), motion[:frames], False))
+            motion = motion[:frames]
+            if motion.fps > KINECT_RATE_HZ:
+                motion = motion.resample(KINECT_RATE_HZ)
+            takes.append(Take(str(path.relative_to(folder)), motion, False))
     return takes
 
 
