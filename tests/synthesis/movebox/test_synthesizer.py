@@ -72,3 +72,15 @@ def test_record_is_the_stream_on_the_display_clock(noisy_kinect, box_truth):
     motion = MoveBox(kinect, box_truth.skeleton).record(30.0)
     assert motion.fps == 30.0
     assert abs(motion.duration_s - (kinect.timestamps[-1] - kinect.timestamps[0])) < 1 / 30
+
+
+def test_registry_drives_a_resized_avatar_for_a_foreign_rig(noisy_kinect):
+    from avatar_models.measure import standing_height
+    from avatar_models.rigs import load_rig
+
+    inputs = MethodInputs(
+        lambda: None, 1.62, load_rig("cmu").skeleton, kinect=noisy_kinect["kinect-v2"]
+    )
+    synth = build("movebox", inputs)
+    assert synth.name == "movebox" and synth.skeleton.name == "avatar"
+    assert standing_height(synth.skeleton) == pytest.approx(1.62)
