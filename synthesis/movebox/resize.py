@@ -21,7 +21,6 @@ from render_cams.kinect import KinectSkeletonStream, TrackingState
 from synthesis.base import SynthesisError
 
 
-
 def head_to_foot_m(kinect: KinectSkeletonStream) -> np.ndarray:
     """``(N,)`` head-joint height over the lower foot joint, in frames where the head and both
     feet are Tracked (NaN elsewhere)."""
