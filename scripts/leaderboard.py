@@ -23,8 +23,8 @@ import numpy as np
 
 from avatar_models.measure import standing_height
 from render_cams import VRSetup
-from render_cams.kinect import kinect_skeleton
 from scripts.method_score import score_method
+from scripts.movebox_eval import filmed
 from scripts.report_html import image_html, page, table_html
 from sim.thresholds import CheckConfig
 from synthesis.base import SynthesisError
@@ -84,7 +84,7 @@ def fold_rows(fold, setup: VRSetup, methods: Sequence[str], checks: CheckConfig,
         stream = setup.sample(trial.motion, seed=trial.seed)
         rig, calibration = ik_rig_for(database().skeleton, trial.motion, setup)
         # MoveBox reads a Kinect V2 of the same take (seeded like the VR stream).
-        kinect = kinect_skeleton(trial.motion, seed=trial.seed) if "movebox" in methods else None
+        kinect = filmed(trial.motion, seed=trial.seed) if "movebox" in methods else None
         inputs = MethodInputs(
             database, standing_height(trial.motion), rig, calibration, dict(overrides), kinect
         )

@@ -31,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from avatar_models import Motion, quat
+from avatar_models.body.errors import RestPoseNotUprightError
 from avatar_models.formats import load_motion
 from avatar_models.generator import generate
 from avatar_models.rigs import body17_positions, load_rig
@@ -62,8 +63,8 @@ LOOP_SEARCH_S = 1.0
 
 @dataclass(frozen=True, eq=False)
 class Take:
-    """One ground-truth motion, its label and the avatar skeleton MoveBox drives (None: the
-    avatar resized to the user from the Kinect stream)."""
+    """One ground-truth motion, its label, and whether MoveBox drives the motion's own
+    avatar-rig skeleton (built-in takes) or the avatar resized to the user (real clips)."""
 
     label: str
     truth: Motion
@@ -97,6 +98,16 @@ def real_takes(folder: Path, per_source: int, duration_s: float) -> list[Take]:
                 motion = motion.resample(KINECT_RATE_HZ)
             takes.append(Take(str(path.relative_to(folder)), motion, False))
     return takes
+
+
+def filmed(motion: Motion, sensor: str = "kinect-v2", seed: int = 0) -> KinectSkeletonStream:
+    """The Kinect stream of ``motion``: filmed on its own body, or, for a rig whose rest pose
+    does not stand (Bandai's), on its humanoid (the motion retargeted onto the avatar body)."""
+    try:
+        return kinect_skeleton(motion, sensor, seed=seed)
+    except RestPoseNotUprightError:
+        humanoid = humanoid_for(motion)
+        return kinect_skeleton(humanoid.motion, sensor, seed=seed, body=humanoid.body)
 
 
 def body17_tracked(kinect: KinectSkeletonStream) -> np.ndarray:

@@ -78,8 +78,12 @@ def read_wav(path: str | Path) -> tuple[int, np.ndarray]:
         ) from exc
     if data.size == 0:
         raise AudioFormatError(f"{path}: the WAV file has no samples")
-    full_scale = float(np.iinfo(data.dtype).max) if np.issubdtype(data.dtype, np.integer) else 1.0
-    samples = data.astype(float) / full_scale
+    if data.dtype == np.uint8:  # 8-bit WAV is unsigned, centred on 128
+        samples = (data.astype(float) - 128.0) / 128.0
+    elif np.issubdtype(data.dtype, np.integer):
+        samples = data.astype(float) / float(np.iinfo(data.dtype).max)
+    else:
+        samples = data.astype(float)
     return int(rate), samples.mean(axis=1) if samples.ndim == 2 else samples
 
 

@@ -79,3 +79,20 @@ def test_face_motion_moves_only_the_face():
     # the chin goes down when the jaw opens
     chin = sk.index("Bip01 JawNub")
     assert m.global_positions()[1, chin, 2] < m.global_positions()[0, chin, 2]
+
+
+@pytest.mark.parametrize("dtype", [np.uint8, np.int16, np.int32, np.float32])
+def test_wav_sample_formats_read_as_unit_floats(tmp_path, dtype):
+    from scipy.io import wavfile
+
+    tone = np.sin(np.linspace(0, 20 * np.pi, 800))
+    if dtype == np.uint8:
+        data = np.round(128 + 127 * tone).astype(dtype)
+    elif np.issubdtype(dtype, np.integer):
+        data = np.round(np.iinfo(dtype).max * tone).astype(dtype)
+    else:
+        data = tone.astype(dtype)
+    wavfile.write(tmp_path / "tone.wav", 8000, np.stack([data, data], axis=1))  # stereo
+    rate, samples = read_wav(tmp_path / "tone.wav")
+    assert rate == 8000 and samples.shape == (800,)
+    assert np.allclose(samples, tone, atol=0.02)
