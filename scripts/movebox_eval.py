@@ -18,9 +18,12 @@ Azure Kinect):
 - ``loop_seam``: similarity index across the seam of the output looped naively (last frame
   to first) and trimmed (:func:`synthesis.movebox.similarity.loop_points`).
 
-Real clips are driven onto the avatar resized to the user from the Kinect's head and foot
-joints (§III-B4); built-in takes onto the subject's own avatar rig. ``lip_sync`` (with
-``--audio``) correlates the jaw with each WAV's RMS envelope.
+MoveBox drives the humanoid's avatar skeleton, as in a scenario: a built-in take's own, a real
+clip's avatar sized to it segment by segment (:func:`sim.humanoid.humanoid_for`);
+``resized_avatar`` is the noise-free retargeting onto the paper's avatar resized uniformly to
+the height measured from the Kinect's head and foot joints (§III-B4), whose proportions are
+not the user's. ``lip_sync`` (with ``--audio``) correlates the jaw with each WAV's RMS
+envelope.
 """
 
 from __future__ import annotations
@@ -63,8 +66,8 @@ LOOP_SEARCH_S = 1.0
 
 @dataclass(frozen=True, eq=False)
 class Take:
-    """One ground-truth motion, its label, and whether MoveBox drives the motion's own
-    avatar-rig skeleton (built-in takes) or the avatar resized to the user (real clips)."""
+    """One ground-truth motion, its label, and whether it is on the avatar rig itself
+    (built-in takes: the roll error needs the truth's own bone frames)."""
 
     label: str
     truth: Motion
@@ -164,9 +167,8 @@ def rms_jerk(motion: Motion) -> float:
     return float(np.sqrt(np.mean(np.sum(jerk**2, axis=-1))))
 
 
-def target_for(take: Take, kinect: KinectSkeletonStream):
-    if take.own_avatar:
-        return take.truth.skeleton
+def resized_avatar(kinect: KinectSkeletonStream):
+    """The avatar resized to the user measured by ``kinect`` (§III-B4)."""
     avatar = load_rig("avatar").skeleton
     return resized(avatar, user_height_m(kinect, avatar))
 
@@ -185,13 +187,15 @@ def evaluate_sensor(
     tracked = body17_tracked(noisy)
     if not tracked.any():
         raise SynthesisError(f"{take.label}: no {sensor} frame tracks every body17 joint")
-    target = target_for(take, noisy)
+    target = humanoid.body.skeleton
+    uniform = resized_avatar(clean)
     row = {
         "tracked_frames_frac": float(tracked.mean()),
         "retarget_err_cm": {
             "noise_free": body17_err_cm(retargeted(clean, target, "hinge"), truth30, tracked),
             "noisy": body17_err_cm(retargeted(noisy, target, "hinge"), truth30, tracked),
             "kinect_err_cm": kinect_err_cm(noisy, truth30, tracked),
+            "resized_avatar": body17_err_cm(retargeted(clean, uniform, "hinge"), truth30, tracked),
         },
     }
     if take.own_avatar:
@@ -303,5 +307,4 @@ def recorded_take(folder: Path) -> MoveBox:
     """
     kinect = read_kinect_skeleton(folder)
     check_stream(kinect)
-    avatar = load_rig("avatar").skeleton
-    return MoveBox(kinect, resized(avatar, user_height_m(kinect, avatar)))
+    return MoveBox(kinect, resized_avatar(kinect))

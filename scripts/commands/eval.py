@@ -84,37 +84,30 @@ def write_leaderboard(board: dict, out: Path, json_out: Path | None) -> None:
 
 
 def _movebox_table(results: dict) -> Table:
-    table = Table(title="movebox (cm, deg, m/s^3; means over takes)")
-    for col in (
-        "source",
-        "sensor",
-        "kinect err",
-        "retarget clean",
-        "retarget noisy",
-        "roll hinge/rest/sensor",
-        "jitter raw/smoothed",
-        "method full",
-        "seam naive/trim",
-    ):
+    """Means per source and sensor: Kinect joint error, retargeting (noise-free, noisy; cm),
+    roll (hinge/rest/sensor; deg), jerk (raw/smoothed; m/s^3), method error, loop seam."""
+    table = Table(title="movebox, means over takes (eval JSON: every number)")
+    for col in ("source", "sensor", "kin cm", "clean", "noisy", "roll h/r/s", "jerk", "full",
+                "seam"):  # fmt: skip
         table.add_column(col, justify="left" if col in ("source", "sensor") else "right")
     for source, sensors in results["summary"].items():
         for sensor, s in sensors.items():
-            r, roll = s["retarget_err_cm"], s.get("roll_err_deg")
+            r, roll, jerk = s["retarget_err_cm"], s.get("roll_err_deg"), s["jitter_m_s3"]
             rolls = (
                 "-"
                 if roll is None
-                else f"{roll['hinge']:.1f}/{roll['rest']:.1f}/{roll['sensor']:.1f}"
+                else "/".join(f"{roll[k]:.0f}" for k in ("hinge", "rest", "sensor"))
             )
             table.add_row(
                 source,
                 sensor,
-                f"{r['kinect_err_cm']:.2f}",
-                f"{r['noise_free']:.3f}",
-                f"{r['noisy']:.2f}",
+                f"{r['kinect_err_cm']:.1f}",
+                f"{r['noise_free']:.2f}",
+                f"{r['noisy']:.1f}",
                 rolls,
-                f"{s['jitter_m_s3']['unsmoothed']:.0f}/{s['jitter_m_s3']['smoothed']:.0f}",
+                f"{jerk['unsmoothed'] / 1e3:.0f}k/{jerk['smoothed'] / 1e3:.0f}k",
                 f"{s['method']['err_cm']['full']:.1f}",
-                f"{s['loop_seam']['naive']:.2f}/{s['loop_seam']['trimmed']:.2f}",
+                f"{s['loop_seam']['naive']:.1f}/{s['loop_seam']['trimmed']:.1f}",
             )
     return table
 
