@@ -18,8 +18,10 @@ Azure Kinect):
 - ``loop_seam``: similarity index across the seam of the output looped naively (last frame
   to first) and trimmed (:func:`synthesis.movebox.similarity.loop_points`).
 
-MoveBox drives the humanoid's avatar skeleton, as in a scenario: a built-in take's own, a real
-clip's avatar sized to it segment by segment (:func:`sim.humanoid.humanoid_for`);
+MoveBox drives what it drives in a scenario (:func:`synthesis.movebox.resize.avatar_for` of
+the humanoid's skeleton): a built-in take's own avatar rig, a Bandai clip's avatar sized to it
+segment by segment (:func:`sim.humanoid.humanoid_for`), for a rig with a body of its own
+(CMU) the avatar resized to the clip's standing height;
 ``resized_avatar`` is the noise-free retargeting onto the paper's avatar resized uniformly to
 the height measured from the Kinect's head and foot joints (§III-B4), whose proportions are
 not the user's. ``lip_sync`` (with ``--audio``) correlates the jaw with each WAV's RMS
@@ -37,6 +39,7 @@ from avatar_models import Motion, quat
 from avatar_models.body.errors import RestPoseNotUprightError
 from avatar_models.formats import load_motion
 from avatar_models.generator import generate
+from avatar_models.measure import standing_height
 from avatar_models.rigs import body17_positions, load_rig
 from render_cams.device import motion_at_rate
 from render_cams.kinect import (
@@ -54,7 +57,7 @@ from synthesis.base import SynthesisError
 from synthesis.movebox import MoveBox, check_stream
 from synthesis.movebox.face import AudioFormatError, lip_sync, read_wav
 from synthesis.movebox.mapping import mapping_for
-from synthesis.movebox.resize import resized, user_height_m
+from synthesis.movebox.resize import avatar_for, resized, user_height_m
 from synthesis.movebox.retarget import ROLLS, Retargeting, twist_angle
 from synthesis.movebox.similarity import loop_points, seam_index
 
@@ -187,7 +190,7 @@ def evaluate_sensor(
     tracked = body17_tracked(noisy)
     if not tracked.any():
         raise SynthesisError(f"{take.label}: no {sensor} frame tracks every body17 joint")
-    target = humanoid.body.skeleton
+    target = avatar_for(humanoid.body.skeleton, standing_height(humanoid.motion))
     uniform = resized_avatar(clean)
     row = {
         "tracked_frames_frac": float(tracked.mean()),

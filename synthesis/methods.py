@@ -17,15 +17,13 @@ from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 from avatar_models import Skeleton
-from avatar_models.rigs import load_rig
 from render_cams.kinect import KinectSkeletonStream
 from render_cams.vr import Attachment
 from synthesis.base import SynthesisError, Synthesizer
 from synthesis.coolmoves import CoolMoves, Database, Options
 from synthesis.ik_baseline import IKBaseline
 from synthesis.movebox import MoveBox
-from synthesis.movebox.mapping import PELVIS
-from synthesis.movebox.resize import resized
+from synthesis.movebox.resize import avatar_for
 
 
 @dataclass(eq=False)
@@ -103,10 +101,7 @@ def movebox(inputs: MethodInputs) -> Synthesizer:
             'movebox reads the Kinect skeleton stream: set [devices] kinect = "kinect-v2" '
             '(or "azure-kinect") in the scenario'
         )
-    target = inputs.rig
-    if PELVIS not in target:
-        target = resized(load_rig("avatar").skeleton, inputs.user_height_m)
-    return MoveBox(inputs.kinect, target)
+    return MoveBox(inputs.kinect, avatar_for(inputs.rig, inputs.user_height_m))
 
 
 METHODS: dict[str, Method] = {

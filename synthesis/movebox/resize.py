@@ -20,6 +20,9 @@ from avatar_models.rigs import identify_rig, load_rig
 from render_cams.kinect import KinectSkeletonStream, TrackingState
 from synthesis.base import SynthesisError
 
+AVATAR_JOINTS = ("Bip01 Pelvis", "Bip01 Spine", "Bip01 L UpperArm", "Bip01 R Thigh")
+"""Joints that tell an avatar-rig skeleton (the 3ds Max Biped names)."""
+
 
 def head_to_foot_m(kinect: KinectSkeletonStream) -> np.ndarray:
     """``(N,)`` head-joint height over the lower foot joint, in frames where the head and both
@@ -59,3 +62,11 @@ def resized(avatar: Skeleton, height_m: float) -> Skeleton:
     if not (np.isfinite(height_m) and height_m > 0):
         raise SynthesisError(f"an avatar height must be positive, got {height_m!r}")
     return avatar.scaled(height_m / standing_height(avatar))
+
+
+def avatar_for(rig: Skeleton, height_m: float) -> Skeleton:
+    """The skeleton MoveBox drives for a user scored on ``rig``: ``rig`` itself when it is an
+    avatar-rig skeleton (any proportions), else the avatar resized to ``height_m``."""
+    if all(name in rig for name in AVATAR_JOINTS):
+        return rig
+    return resized(load_rig("avatar").skeleton, height_m)

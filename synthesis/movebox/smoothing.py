@@ -9,6 +9,12 @@ towards the latest Kinect pose (sample-and-hold: a live system sees no later fra
 normalised (the normalised-lerp form of ``slerp(s_{k-1}, x_k, alpha)``; equal to first order,
 and one linear filter, so a batch is one ``scipy.signal.lfilter`` call and cut anywhere it
 gives the same result). ``alpha`` comes from a time constant: ``1 - exp(-dt / tau)``.
+
+The rotations smoothed are the absolute ones, ``q_absolute = prod q_i`` down the hierarchy
+(:func:`absolute`), then turned back into local ones (:func:`relative`): a parent whose roll
+jumps (a V2 elbow straightening, say) then spins about its own bone while its child, aimed
+at its own Kinect joint, stays put; smoothing local rotations instead would swing the child
+through the parent's turn (measured on a Bandai take: RMS body17 jerk 2.2x the unsmoothed).
 """
 
 from __future__ import annotations
@@ -28,6 +34,20 @@ removes the 30 Hz staircase at 90 Hz and most sensor jitter for 33 ms of lag."""
 def smoothing_alpha(rate_hz: float, tau_s: float = TIME_CONSTANT_S) -> float:
     """The share per tick at ``rate_hz`` for time constant ``tau_s`` (1: no smoothing)."""
     return 1.0 if tau_s <= 0 else float(1.0 - np.exp(-1.0 / (rate_hz * tau_s)))
+
+
+def absolute(local_rot: np.ndarray, parents: np.ndarray) -> np.ndarray:
+    """``(..., J, 4)`` absolute rotations of local rotations ``(..., J, 4)`` (parents first)."""
+    out = np.array(local_rot, dtype=float)
+    for j in range(1, out.shape[-2]):
+        out[..., j, :] = quat.mul(out[..., parents[j], :], out[..., j, :])
+    return out
+
+
+def relative(world_rot: np.ndarray, parents: np.ndarray) -> np.ndarray:
+    """``(..., J, 4)`` local rotations of absolute ones (the inverse of :func:`absolute`)."""
+    local = quat.mul(quat.conj(world_rot[..., parents[1:], :]), world_rot[..., 1:, :])
+    return np.concatenate([world_rot[..., :1, :], local], axis=-2)
 
 
 def align_signs(q: np.ndarray, previous: np.ndarray | None) -> np.ndarray:

@@ -6,7 +6,8 @@ tick uses only the Kinect frames stamped at or before it. Per new Kinect frame:
 :class:`~synthesis.movebox.retarget.Retargeting` (q_absolute down the hierarchy, roll,
 wrist stabilisation), then :class:`~synthesis.movebox.confidence.ConfidenceFilter`
 (NotTracked held, Inferred blended, never-seen at rest); per display tick: the latest
-frame, smoothed (:mod:`.smoothing`), which also carries 30 Hz onto 90 Hz.
+frame, its absolute rotations smoothed (:mod:`.smoothing`), which also carries 30 Hz onto
+90 Hz.
 
 Shapes: ``B`` ticks, ``N`` Kinect frames, ``K`` Kinect joints, ``J`` avatar joints.
 """
@@ -22,7 +23,13 @@ from synthesis.base import DEFAULT_RATE_HZ, FrameBatch, Poses, SynthesisError, S
 from synthesis.movebox.confidence import ConfidenceFilter, bone_states, forward_fill
 from synthesis.movebox.mapping import PELVIS, mapping_for
 from synthesis.movebox.retarget import ROLLS, Retargeting
-from synthesis.movebox.smoothing import TIME_CONSTANT_S, ExponentialSmoother, smoothing_alpha
+from synthesis.movebox.smoothing import (
+    TIME_CONSTANT_S,
+    ExponentialSmoother,
+    absolute,
+    relative,
+    smoothing_alpha,
+)
 
 DEFAULT_ROLL = {"kinect_v2": "hinge", "azure_kinect": "sensor"}
 """Roll per sensor: V2 has none of its own (§IV-B1): the avatar's rest roll with its hinge
@@ -147,7 +154,9 @@ class MoveBox(Synthesizer):
         if local.shape[0]:
             self._consumed = available
             self._last_root, self._last_rot = root[-1:], local[-1:]
-        return Poses(self._smoother("root", roots, False), self._smoother("rot", rots, True))
+        parents = self.skeleton.parents
+        world = self._smoother("rot", absolute(rots, parents), True)
+        return Poses(self._smoother("root", roots, False), relative(world, parents))
 
     def record(self, rate_hz: float = DEFAULT_RATE_HZ) -> Motion:
         """The whole Kinect stream as an animation (MoveBox's recording, §III-B1): a fresh
