@@ -38,3 +38,13 @@ def test_smoothing_reduces_rotation_jitter():
 
     # seeds 0-4: ratio 0.16-0.18
     assert jitter(smooth) < 0.3 * jitter(noisy)
+
+
+def test_absolute_is_the_product_down_the_hierarchy_and_relative_undoes_it(box_truth):
+    from synthesis.movebox.smoothing import absolute, relative
+
+    local = box_truth.local_rot[:5]
+    world = absolute(local, box_truth.skeleton.parents)
+    # q_absolute (MoveBox §III-A1) is what forward kinematics composes
+    assert np.allclose(np.abs(np.sum(world * box_truth.global_rotations()[:5], -1)), 1.0)
+    assert np.allclose(relative(world, box_truth.skeleton.parents), local)
