@@ -36,11 +36,21 @@ def smoothing_alpha(rate_hz: float, tau_s: float = TIME_CONSTANT_S) -> float:
     return 1.0 if tau_s <= 0 else float(1.0 - np.exp(-1.0 / (rate_hz * tau_s)))
 
 
+def depth_levels(parents: np.ndarray) -> list[np.ndarray]:
+    """Joint indices by depth below the root (depth 1 first): each level's parents are all
+    in the levels before it, so a level composes in one vectorised product."""
+    depth = np.zeros(len(parents), int)
+    for j in range(1, len(parents)):  # parents come before children
+        depth[j] = depth[parents[j]] + 1
+    return [np.flatnonzero(depth == d) for d in range(1, depth.max() + 1)]
+
+
 def absolute(local_rot: np.ndarray, parents: np.ndarray) -> np.ndarray:
-    """``(..., J, 4)`` absolute rotations of local rotations ``(..., J, 4)`` (parents first)."""
+    """``(..., J, 4)`` absolute rotations of local rotations ``(..., J, 4)`` (parents first),
+    one product per depth level."""
     out = np.array(local_rot, dtype=float)
-    for j in range(1, out.shape[-2]):
-        out[..., j, :] = quat.mul(out[..., parents[j], :], out[..., j, :])
+    for level in depth_levels(np.asarray(parents)):
+        out[..., level, :] = quat.mul(out[..., parents[level], :], out[..., level, :])
     return out
 
 
