@@ -4,7 +4,8 @@ accuracy, for the physics of its output and for speed (``avatarsim eval leaderbo
 Per fold of the protocol (:func:`synthesis.evaluate.folds`): the database of the fold's
 training trials (built once, shared by every CoolMoves variant), the distance threshold
 chosen on the training data (:mod:`synthesis.evaluate.validation`), and per test trial one
-VR stream that every method (:data:`synthesis.methods.METHODS`) runs on, through
+VR stream (and, for MoveBox, one Kinect V2 skeleton stream) that every method
+(:data:`synthesis.methods.METHODS`) runs on, through
 :func:`scripts.method_score.score_method` (timed ``step`` calls included). A method's numbers
 are means over the trials of a class, then over classes (each class counts once, as the
 paper averages over activities); latency percentiles are those of all steps of a trial,
@@ -24,6 +25,7 @@ from avatar_models.measure import standing_height
 from render_cams import VRSetup
 from render_cams.vr import FULL_BODY
 from scripts.method_score import score_method
+from scripts.movebox_eval import filmed
 from scripts.report_html import image_html, page, table_html
 from sim.thresholds import CheckConfig
 from synthesis.avatargo.study import walk_in
@@ -84,13 +86,16 @@ def fold_rows(fold, setup: VRSetup, methods: Sequence[str], checks: CheckConfig,
     for trial in fold.test:
         stream = setup.sample(trial.motion, seed=trial.seed)
         rig, calibration = ik_rig_for(database().skeleton, trial.motion, setup)
+        # MoveBox reads a Kinect V2 of the same take (seeded like the VR stream).
+        kinect = filmed(trial.motion, seed=trial.seed) if "movebox" in methods else None
         inputs = MethodInputs(
             database,
             standing_height(trial.motion),
             rig,
             calibration,
             dict(overrides),
-            walk_in(setup, trial.motion.skeleton, trial.seed) if trackers else None,
+            walk_in=walk_in(setup, trial.motion.skeleton, trial.seed) if trackers else None,
+            kinect=kinect,
         )
         for name in methods:
             result = score_method(build(name, inputs), trial.motion, stream, checks, True)

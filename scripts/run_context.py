@@ -9,6 +9,7 @@ from typing import Any
 from rich.console import Console
 
 from avatar_models.motion import Motion
+from render_cams.kinect import KinectSkeletonStream
 from render_cams.tracking import TrackingStream
 from scripts.results import ThresholdResult
 from scripts.scenario import Scenario
@@ -28,6 +29,8 @@ class RunContext:
         walk_in: the VR devices' sample while the user stands in a T-pose before the session
             (stage ``devices``, with ``[devices] trackers``; None without), AvatarGo's
             walk-in calibration.
+        kinect_stream: the Kinect skeleton stream (stage ``devices``; None without
+            ``[devices] kinect``), MoveBox's input.
         synthesised: each method's output on the humanoid, by method name (stage
             ``synthesis``; empty without ``[synthesis]``).
         metrics: thresholded by ``[thresholds]``.
@@ -43,6 +46,7 @@ class RunContext:
     humanoid: Humanoid | None = None
     vr_stream: TrackingStream | None = None
     walk_in: TrackingFrame | None = None
+    kinect_stream: KinectSkeletonStream | None = None
     synthesised: dict[str, Humanoid] = field(default_factory=dict)
     metrics: dict[str, float] = field(default_factory=dict)
     checks: list[ThresholdResult] = field(default_factory=list)

@@ -39,8 +39,10 @@ from typing import Any
 
 from avatar_models.errors import AvatarsimError
 from avatar_models.motion import FPS_RANGE
+from render_cams.kinect.sensors import SENSORS
 
 VR_NOISE = ("none", "realistic")
+KINECT_SENSORS = tuple(SENSORS)
 # sim.corrupt's defects a scenario's motion can be given (``motion.corrupt``), each one that a
 # physics check must flag (scripts/corruption.py applies them).
 CORRUPTIONS = ("sink_feet", "float_body", "bend_knee", "inject_sliding", "add_jitter")
@@ -95,9 +97,11 @@ class DevicesSpec:
     """Simulated VR tracking (``render_cams.vr``); ``noise`` is ``"none"`` or ``"realistic"``
     (Lighthouse-grade jitter, latency, slow drift). For sweeps, ``latency_s``, ``jitter_m``
     (position, per axis) and ``dropouts_per_s`` (0.5 s bursts of tracking loss) add one
-    more model each, after the preset."""
+    more model each, after the preset. ``kinect`` (``"kinect-v2"`` or ``"azure-kinect"``)
+    also records the Kinect skeleton stream (30 Hz) that MoveBox runs on."""
 
     vr: bool = True
+    kinect: str | None = None
     trackers: bool = False
     noise: str = "realistic"
     latency_s: float = 0.0
@@ -247,6 +251,9 @@ def parse_scenario(data: dict[str, Any], path: str | None = None) -> Scenario:
         value = getattr(optional["devices"], key, 0.0)
         if not 0 <= value <= most:
             raise ScenarioError(f"devices.{key} must be 0-{most:g}, got {value}")
+    kinect = getattr(optional["devices"], "kinect", None)
+    if kinect is not None and kinect not in KINECT_SENSORS:
+        raise ScenarioError(f"devices.kinect must be one of {KINECT_SENSORS}, got {kinect!r}")
     if optional["synthesis"] and not optional["devices"]:
         raise ScenarioError("[synthesis] needs a [devices] table (the VR stream it runs on)")
     synthesis = optional["synthesis"]

@@ -17,11 +17,14 @@ from dataclasses import dataclass, field, replace
 from functools import cached_property
 
 from avatar_models import Skeleton
+from render_cams.kinect import KinectSkeletonStream
 from render_cams.vr import Attachment
 from synthesis.avatargo import AvatarGo
 from synthesis.base import SynthesisError, Synthesizer, TrackingFrame
 from synthesis.coolmoves import CoolMoves, Database, Options
 from synthesis.ik_baseline import IKBaseline
+from synthesis.movebox import MoveBox
+from synthesis.movebox.resize import avatar_for
 
 
 @dataclass(eq=False)
@@ -43,6 +46,8 @@ class MethodInputs:
         walk_in: AvatarGo's walk-in sample (§3.2): the six devices (headset, controllers,
             three Vive trackers) while the user stands in a T-pose, or None where the
             trackers are off.
+        kinect: the Kinect skeleton stream of the same take (``[devices] kinect``), for
+            MoveBox; None where no Kinect was recorded.
     """
 
     database_factory: Callable[[], Database]
@@ -51,6 +56,7 @@ class MethodInputs:
     calibration: Sequence[Attachment] | None = None
     coolmoves: dict = field(default_factory=dict)
     walk_in: TrackingFrame | None = None
+    kinect: KinectSkeletonStream | None = None
 
     @cached_property
     def database(self) -> Database:
@@ -105,6 +111,21 @@ def avatargo(name: str, summary: str, offsets: str) -> Method:
     return Method(name, summary, build)
 
 
+def movebox(inputs: MethodInputs) -> Synthesizer:
+    """MoveBox on the inputs' Kinect stream (:class:`~synthesis.movebox.MoveBox`), driving the
+    scored rig when it is an avatar rig, else the avatar rig resized to the user.
+
+    Raises:
+        SynthesisError: no Kinect stream (the message says which ``[devices]`` entry to set).
+    """
+    if inputs.kinect is None:
+        raise SynthesisError(
+            'movebox reads the Kinect skeleton stream: set [devices] kinect = "kinect-v2" '
+            '(or "azure-kinect") in the scenario'
+        )
+    return MoveBox(inputs.kinect, avatar_for(inputs.rig, inputs.user_height_m))
+
+
 METHODS: dict[str, Method] = {
     m.name: m
     for m in (
@@ -133,9 +154,14 @@ METHODS: dict[str, Method] = {
             "AvatarGo with the fixed root/feet tracker offsets it argues against (§3.3)",
             "fixed",
         ),
+        Method(
+            "movebox",
+            "MoveBox: the Kinect skeleton retargeted onto the avatar (§III-A1; [devices] kinect)",
+            movebox,
+        ),
     )
 }
-"""Every registered method by name (AvatarGo, MoveBox and ControllerPose join as they land)."""
+"""Every registered method by name."""
 
 
 def method(name: str) -> Method:

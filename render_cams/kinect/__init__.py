@@ -19,7 +19,7 @@ from render_cams.kinect.placement import (
     yaw_pitch_pose,
 )
 from render_cams.kinect.sensors import SENSORS, DepthSensor, KinectError, get_sensor
-from render_cams.kinect.sequence import write_kinect_recording
+from render_cams.kinect.sequence import read_kinect_skeleton, write_kinect_recording
 from render_cams.kinect.skeleton import (
     KinectSkeletonStream,
     SkeletonNoise,
@@ -41,6 +41,7 @@ __all__ = [
     "default_sensor_pose",
     "get_sensor",
     "kinect_skeleton",
+    "read_kinect_skeleton",
     "write_kinect_recording",
     "look_at",
     "yaw_pitch_pose",

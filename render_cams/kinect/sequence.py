@@ -7,6 +7,8 @@ Layout of ``out_dir``::
     skeleton/000000.json    joints (world and camera space), orientations, tracking states
     preview.mp4             colour-mapped depth with the skeleton drawn on it
     recording.json          device, K, image size, sensor pose, seed, frame count, fps
+
+:func:`read_kinect_skeleton` reads the skeleton stream back (MoveBox plays recorded takes).
 """
 
 from __future__ import annotations
@@ -20,7 +22,7 @@ import numpy as np
 
 from render_cams.kinect.depth import colourise, write_png
 from render_cams.kinect.device import KinectRecording
-from render_cams.kinect.sensors import DepthSensor
+from render_cams.kinect.sensors import DepthSensor, KinectError
 from render_cams.kinect.skeleton import KinectSkeletonStream, TrackingState
 
 _STATE_BGR = {
@@ -70,3 +72,52 @@ def _preview(
         v = int(round(K[1, 1] * point[1] / point[2] + K[1, 2]))
         cv2.circle(image, (u, v), 3, _STATE_BGR[TrackingState(int(state))], -1)
     return image
+
+
+def read_kinect_skeleton(folder: str | Path) -> KinectSkeletonStream:
+    """The skeleton stream of a recording folder written by :func:`write_kinect_recording`
+    (``skeleton/*.json`` and ``recording.json``): NotTracked joints come back with NaN
+    positions and identity orientations, as the SDK reports no data for them.
+
+    Raises:
+        KinectError: no such folder, no skeleton frame, or a malformed frame.
+    """
+    folder = Path(folder)
+    paths = sorted((folder / "skeleton").glob("*.json"))
+    if not paths:
+        raise KinectError(f"{folder}: no Kinect skeleton frames (skeleton/*.json)")
+    try:
+        record = json.loads((folder / "recording.json").read_text())
+        frames = [json.loads(p.read_text()) for p in paths]
+        names = tuple(j["name"] for j in frames[0]["joints"])
+        states = np.array(
+            [[TrackingState[j["tracking_state"]] for j in f["joints"]] for f in frames], np.int8
+        )
+        positions = np.array(
+            [[j["position_world_m"] or [np.nan] * 3 for j in f["joints"]] for f in frames], float
+        )
+        orientations = np.array(
+            [[j["orientation_wxyz"] or [1.0, 0, 0, 0] for j in f["joints"]] for f in frames], float
+        )
+        timestamps = np.array([f["timestamp_s"] for f in frames], float)
+        stream = KinectSkeletonStream(
+            rig=frames[0]["rig"],
+            joint_names=names,
+            timestamps=timestamps,
+            positions=positions,
+            orientations=orientations,
+            states=states,
+            sensor_pose=np.array(record["camera_to_world"], float),
+            meta={
+                "device": record.get("device"),
+                "rate_hz": record.get("fps"),
+                "source": str(folder),
+            },
+        )
+    except (OSError, ValueError, KeyError, TypeError, IndexError) as exc:
+        raise KinectError(
+            f"{folder}: not a Kinect recording ({type(exc).__name__}: {exc})"
+        ) from exc
+    if positions.shape != (len(frames), len(names), 3):
+        raise KinectError(f"{folder}: frames disagree on their joints")
+    return stream

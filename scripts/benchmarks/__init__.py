@@ -20,6 +20,7 @@ BENCHMARKS: dict[str, str] = {
     "cameras": "cameras",
     "sensing": "sensing",
     "kinect": "kinect",
+    "movebox": "movebox",
     "control": "control",
     "suite": "suite",
 }

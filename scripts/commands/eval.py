@@ -125,6 +125,91 @@ def write_avatargo(results: dict, out: Path, json_out: Path | None) -> None:
     console.print(f"wrote {out}/avatargo.json and avatargo.png")
 
 
+def _movebox_table(results: dict) -> Table:
+    """Means per source and sensor: Kinect joint error, retargeting (noise-free, noisy; cm),
+    roll (hinge/rest/sensor; deg), jerk (raw/smoothed; m/s^3), method error, loop seam."""
+    table = Table(title="movebox, means over takes (eval JSON: every number)")
+    for col in ("source", "sensor", "kin cm", "clean", "noisy", "roll h/r/s", "jerk", "full",
+                "seam"):  # fmt: skip
+        table.add_column(col, justify="left" if col in ("source", "sensor") else "right")
+    for source, sensors in results["summary"].items():
+        for sensor, s in sensors.items():
+            r, roll, jerk = s["retarget_err_cm"], s.get("roll_err_deg"), s["jitter_m_s3"]
+            rolls = (
+                "-"
+                if roll is None
+                else "/".join(f"{roll[k]:.0f}" for k in ("hinge", "rest", "sensor"))
+            )
+            table.add_row(
+                source,
+                sensor,
+                f"{r['kinect_err_cm']:.1f}",
+                f"{r['noise_free']:.2f}",
+                f"{r['noisy']:.1f}",
+                rolls,
+                f"{jerk['unsmoothed'] / 1e3:.0f}k/{jerk['smoothed'] / 1e3:.0f}k",
+                f"{s['method']['err_cm']['full']:.1f}",
+                f"{s['loop_seam']['naive']:.1f}/{s['loop_seam']['trimmed']:.1f}",
+            )
+    return table
+
+
+def run_movebox(library, out, wanted, per_source, duration, quick, audio, kinect, seed, json_out):
+    """``eval movebox``: inputs checked first (audio, recorded take), then the evaluation
+    (:mod:`scripts.movebox_eval`), the story (:mod:`scripts.movebox_story`) and, with
+    ``--kinect``, the recorded take retargeted and saved."""
+    from avatar_models.formats import save_motion
+    from scripts.movebox_eval import (
+        ACTIVITIES,
+        audio_files,
+        builtin_takes,
+        real_takes,
+        recorded_take,
+        run_movebox_eval,
+    )
+    from scripts.movebox_story import write_story
+    from synthesis.base import SynthesisError
+
+    files = audio_files(audio) if audio is not None else []
+    take = recorded_take(kinect) if kinect is not None else None
+    duration = min(duration, 2.0) if quick else duration
+    if library == "builtin":
+        chosen = wanted or (["walk"] if quick else list(ACTIVITIES))
+        unknown = sorted(set(chosen) - set(ACTIVITIES))
+        if unknown:
+            raise SynthesisError(f"movebox evaluates {', '.join(ACTIVITIES)}; not {unknown}")
+        takes = builtin_takes(chosen, duration, seed)
+    else:
+        folder = Path(library)
+        if not folder.is_dir():
+            raise SynthesisError(f"--library must be 'builtin' or a folder; {folder} is not")
+        takes = real_takes(folder, per_source or 1, duration)
+    with Progress(console=err_console, transient=True) as bar:
+        task = bar.add_task("movebox", total=len(takes))
+        results = run_movebox_eval(
+            takes,
+            seed=seed,
+            audio=files,
+            progress=lambda done, total, label: bar.update(
+                task, completed=done, description=escape(label)
+            ),
+        )
+    results.update(library=library, quick=quick)
+    console.print(_movebox_table(results))
+    for name, row in results.get("lip_sync", {}).items():
+        console.print(f"lip sync {escape(name)}: jaw vs RMS envelope r = {row['r_jaw_rms']:.3f}")
+    results["story"] = write_story(out / "story", 2.0 if quick else 4.0, seed, (files or [None])[0])
+    if take is not None:
+        recording = take.record()
+        results["take"] = {
+            "frames": recording.n_frames,
+            "files": [str(save_motion(recording, out / f"take{ext}")) for ext in (".npz", ".bvh")],
+        }
+    emit_json(out / "movebox.json", results)
+    emit_json(json_out, results)
+    console.print(f"wrote {out}/movebox.json and {out}/story/ (story.mp4, story.xml)")
+
+
 def register(app: typer.Typer) -> None:
     @app.command(name="eval")
     @user_errors
@@ -136,7 +221,8 @@ def register(app: typer.Typer) -> None:
                 "coolmoves-centroid-align (synthesis.methods), leaderboard: every "
                 "registered method on the same test motions, accuracy, physics and latency, "
                 "or avatargo: its simulated user study, exact vs fixed offsets (one user "
-                "per test motion)."
+                "per test motion), "
+                "or movebox: MoveBox's retargeting, roll, smoothing, loops, lip sync and story."
             ),
         ],
         library: Annotated[
@@ -166,6 +252,14 @@ def register(app: typer.Typer) -> None:
             int, typer.Option(help="Database copies turned to this many yaws (beyond the paper).")
         ] = 1,
         quick: Annotated[bool, typer.Option(help="Small inputs, for a smoke run.")] = False,
+        audio: Annotated[
+            Path | None,
+            typer.Option(help="movebox: a WAV file or folder for lip sync (the story's voice)."),
+        ] = None,
+        kinect: Annotated[
+            Path | None,
+            typer.Option(help="movebox: a recorded Kinect take folder to retarget and save."),
+        ] = None,
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
     ) -> None:
@@ -194,10 +288,16 @@ def register(app: typer.Typer) -> None:
             if not lo <= value <= hi:  # also NaN
                 raise EvaluationError(f"{option} must be {lo:g}-{hi:g}, got {value}")
         check_outputs(json_out=json_out, out=out)
+        if method == "movebox":
+            keep = None if classes is None else [c.strip() for c in classes.split(",") if c.strip()]
+            run_movebox(
+                library, out, keep, max_per_class, duration, quick, audio, kinect, seed, json_out
+            )
+            return
         if method not in (*EVALUABLE, "leaderboard", "avatargo"):
             raise EvaluationError(
                 f"unknown method {method!r}; available: {', '.join(EVALUABLE)}, leaderboard, "
-                "avatargo"
+                "avatargo, movebox"
             )
         if protocol not in PROTOCOLS:
             raise EvaluationError(f"unknown protocol {protocol!r}; use {' or '.join(PROTOCOLS)}")

@@ -1,7 +1,11 @@
-"""Simulated VR tracking of the ground truth: headset and controllers (+ Vive trackers) at 90 Hz."""
+"""Simulated tracking of the ground truth: VR headset and controllers (+ Vive trackers) at 90 Hz,
+and, with ``[devices] kinect``, a Kinect skeleton stream at 30 Hz (MoveBox's input)."""
 
 from __future__ import annotations
 
+import numpy as np
+
+from render_cams.kinect import TrackingState, kinect_skeleton
 from render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
 from render_cams.vr.dropouts import Dropouts
 from render_cams.vr.noise import Drift, Latency, PositionJitter, RotationJitter
@@ -9,7 +13,10 @@ from scripts.run_context import RunContext
 from scripts.scenario import Scenario
 from synthesis.avatargo.study import walk_in
 
-METRICS = {"vr_valid_frac": "share of valid VR samples over all devices"}
+METRICS = {
+    "vr_valid_frac": "share of valid VR samples over all devices",
+    "kinect_tracked_frac": "share of Tracked Kinect joint samples",
+}
 
 # Lighthouse-grade jitter and drift (render_cams.vr.noise defaults) and one 90 Hz frame of
 # tracking latency; latency first, since it shifts whole samples.
@@ -17,7 +24,10 @@ REALISTIC_NOISE = (Latency(seconds=1 / 90), PositionJitter(), RotationJitter(), 
 
 
 def metrics_for(scenario: Scenario) -> set[str]:
-    return set(METRICS) if scenario.devices is not None and scenario.devices.vr else set()
+    spec = scenario.devices
+    if spec is None:
+        return set()
+    return {k for k, on in (("vr_valid_frac", spec.vr), ("kinect_tracked_frac", spec.kinect)) if on}
 
 
 def setup(ctx: RunContext) -> VRSetup:
@@ -33,8 +43,27 @@ def setup(ctx: RunContext) -> VRSetup:
     return VRSetup(devices=devices, noise=noise)
 
 
+def record_kinect(ctx: RunContext) -> None:
+    """The Kinect skeleton stream of the motion on the humanoid (``[devices] kinect``)."""
+    spec = ctx.scenario.devices
+    stream = kinect_skeleton(
+        ctx.humanoid.motion, spec.kinect, seed=ctx.scenario.seed, body=ctx.humanoid.body
+    )
+    ctx.kinect_stream = stream
+    ctx.metrics["kinect_tracked_frac"] = float(np.mean(stream.states == TrackingState.TRACKED))
+    ctx.info.setdefault("devices", {})["kinect"] = {
+        "device": spec.kinect,
+        "rig": stream.rig,
+        "samples": stream.n_samples,
+    }
+
+
 def run(ctx: RunContext) -> None:
-    if ctx.scenario.devices is None or not ctx.scenario.devices.vr:
+    if ctx.scenario.devices is None:
+        return
+    if ctx.scenario.devices.kinect:
+        record_kinect(ctx)
+    if not ctx.scenario.devices.vr:
         return
     vr = setup(ctx)
     stream = vr.sample(ctx.motion, seed=ctx.scenario.seed)
@@ -42,10 +71,12 @@ def run(ctx: RunContext) -> None:
     if ctx.scenario.devices.trackers:  # AvatarGo's walk-in T-pose, with the same devices
         ctx.walk_in = walk_in(vr, ctx.motion.skeleton, ctx.scenario.seed)
     ctx.metrics["vr_valid_frac"] = float(stream.valid.mean())
-    ctx.info["devices"] = {
-        "vr": list(stream.device_names),
-        "rate_hz": vr.rate_hz,
-        "samples": int(stream.timestamps.size),
-        "noise": ctx.scenario.devices.noise,
-    }
+    ctx.info.setdefault("devices", {}).update(
+        {
+            "vr": list(stream.device_names),
+            "rate_hz": vr.rate_hz,
+            "samples": int(stream.timestamps.size),
+            "noise": ctx.scenario.devices.noise,
+        }
+    )
     ctx.output("vr_stream", stream.to_npz(ctx.out_dir / "vr_stream.npz"))

@@ -80,6 +80,7 @@ def method_inputs(ctx: RunContext, user_height_m: float) -> MethodInputs:
         calibration=ik_calibration(ctx),
         coolmoves={"foot_contact": ctx.scenario.synthesis.foot_contact},
         walk_in=ctx.walk_in,
+        kinect=ctx.kinect_stream,
     )
 
 

@@ -6,11 +6,13 @@ import json
 
 import cv2
 import numpy as np
+import pytest
 
+from render_cams.kinect import KinectError, TrackingState
 from render_cams.kinect.depth import BODY_INDEX_NONE, read_depth_png
 from render_cams.kinect.device import Kinect
 from render_cams.kinect.placement import performer_distance
-from render_cams.kinect.sequence import write_kinect_recording
+from render_cams.kinect.sequence import read_kinect_skeleton, write_kinect_recording
 from tests.render_cams.builders import folder_bytes
 from tests.render_cams.kinect_builders import t_pose
 
@@ -34,3 +36,16 @@ def test_sequence_writes_depth_body_index_skeleton_and_preview(tmp_path):
     assert folder_bytes(tmp_path / "a") == folder_bytes(tmp_path / "b")  # incl. the preview
     assert json.loads((tmp_path / "a" / "recording.json").read_text())["device"] == "azure-kinect"
     assert again == record
+    # The skeleton stream reads back (MoveBox plays recorded takes); NotTracked joints have
+    # no position on disk and come back NaN.
+    stream = kinect.sample(motion, seed=5).skeleton
+    back = read_kinect_skeleton(tmp_path / "a")
+    assert back.joint_names == stream.joint_names and np.array_equal(back.states, stream.states)
+    seen = stream.states != TrackingState.NOT_TRACKED
+    assert np.allclose(back.positions[seen], stream.positions[seen], atol=1e-5)
+    assert np.isnan(back.positions[~seen]).all()
+
+
+def test_reading_a_folder_without_frames_raises(tmp_path):
+    with pytest.raises(KinectError, match="no Kinect skeleton frames"):
+        read_kinect_skeleton(tmp_path)

@@ -41,6 +41,7 @@ def test_default_scenario_is_valid():
         ({"motion": {"corrupt": "melt"}}, "motion.corrupt must be one of"),
         ({"devices": {"latency_s": 5.0}}, "devices.latency_s must be 0-1"),
         ({"devices": {"dropouts_per_s": -1}}, "devices.dropouts_per_s must be 0-10"),
+        ({"devices": {"kinect": "kinect-v9"}}, "devices.kinect must be one of"),
     ],
 )
 def test_invalid_scenarios_name_the_problem(data, message):

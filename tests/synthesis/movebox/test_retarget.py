@@ -1,0 +1,109 @@
+"""Retargeting: noise-free Kinect joints reproduce the source pose on body17; roll recovery
+finds a turned forearm and a rolled upper arm again."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from avatar_models import Motion, quat
+from avatar_models.rigs import body17_positions, load_rig
+from render_cams.device import motion_at_rate
+from render_cams.kinect.rig_joints import rig_joints
+from synthesis.movebox.mapping import mapping_for
+from synthesis.movebox.retarget import Retargeting, shortest_arc, twist_angle
+from tests.synthesis.movebox.conftest import SENSORS
+
+RIGS = {"kinect-v2": "kinect_v2", "azure-kinect": "azure_kinect"}
+
+
+def retarget(positions, orientations, rig_name, target, roll):
+    rig = load_rig(rig_name)
+    r = Retargeting(
+        target, mapping_for(rig_name), rig.skeleton.rest_positions(), rig.skeleton.names, roll
+    )
+    return r(positions, orientations)
+
+
+@pytest.mark.parametrize("sensor", SENSORS)
+@pytest.mark.parametrize("roll", ["hinge", "rest", "sensor"])
+def test_noise_free_kinect_reproduces_body17_within_1cm(box_truth, clean_kinect, sensor, roll):
+    kinect = clean_kinect[sensor]
+    root, local = retarget(
+        kinect.positions, kinect.orientations, kinect.rig, box_truth.skeleton, roll
+    )
+    out = Motion(box_truth.skeleton, 30.0, root, local)
+    truth = body17_positions(motion_at_rate(box_truth, 30.0))
+    err = np.linalg.norm(body17_positions(out) - truth, axis=-1)
+    # Measured (box, walk, squat; both sensors): mean 0.01-0.06 cm, max 1.0 cm (Azure squat
+    # heads, whose neck-head bone the sensor turns with the head); the issue's bound is 1 cm.
+    assert err.mean(axis=0).max() < 1.0
+    assert np.percentile(err, 99) < 1.0
+
+
+def arm_motion(upper_arm: np.ndarray, forearm: np.ndarray) -> Motion:
+    """The avatar in rest pose but for the left upper arm and forearm local rotations
+    ``(T, 4)`` each."""
+    sk = load_rig("avatar").skeleton
+    rot = np.tile(quat.IDENTITY, (len(upper_arm), sk.n_joints, 1))
+    rot[:, sk.index("Bip01 L UpperArm")] = upper_arm
+    rot[:, sk.index("Bip01 L Forearm")] = forearm
+    return Motion(sk, 30.0, np.tile(sk.offsets[0], (len(upper_arm), 1)), rot)
+
+
+def v2_retarget(motion: Motion, roll: str) -> Motion:
+    rig = load_rig("kinect_v2")
+    positions, orientations = rig_joints(motion, rig)
+    root, local = retarget(positions, orientations, "kinect_v2", motion.skeleton, roll)
+    return Motion(motion.skeleton, motion.fps, root, local)
+
+
+def test_roll_recovery_finds_a_forearm_turn():
+    """The forearm turns (elbow flexion, -z for the left arm) by 20-120 deg while the upper
+    arm is raised forwards; Kinect V2 sees bones only, yet the forearm's turn comes back."""
+    turns = np.deg2rad(np.arange(20, 121, 10.0))
+    raise_forward = quat.from_axis_angle(np.array([0.0, 0, 1]), np.full(turns.size, 1.0))
+    turn = quat.from_axis_angle(np.array([0.0, 0, 1]), -turns)
+    out = v2_retarget(arm_motion(raise_forward, turn), "hinge")
+    forearm = out.local_rot[:, out.skeleton.index("Bip01 L Forearm")]
+    # The recovered local rotation is the turn itself (angle and axis).
+    found = quat.angle(quat.mul(forearm, quat.conj(turn)))
+    assert np.rad2deg(found).max() < 1.0
+
+
+def test_roll_recovery_finds_an_upper_arm_roll_that_sensor_roll_misses():
+    """With the elbow bent 90 deg, the upper arm rolls about its own axis by -60..60 deg;
+    hinge recovery finds the roll (the bend plane shows it), V2's own orientation does not."""
+    rolls = np.deg2rad(np.arange(-60, 61, 15.0))
+    roll = quat.from_axis_angle(np.array([0.0, 1, 0]), rolls)
+    bent = quat.from_axis_angle(np.array([0.0, 0, 1]), np.full(rolls.size, -np.pi / 2))
+    truth = arm_motion(roll, bent)
+    j = truth.skeleton.index("Bip01 L UpperArm")
+    axis = np.array([0.0, 1.0, 0.0])
+    errors = {}
+    for mode in ("hinge", "sensor"):
+        out = v2_retarget(truth, mode)
+        rel = quat.mul(quat.conj(truth.global_rotations()[:, j]), out.global_rotations()[:, j])
+        errors[mode] = np.rad2deg(np.abs(twist_angle(rel, axis)))
+    assert errors["hinge"].max() < 1.0
+    # V2's swing-only orientation has no roll: it misses each roll by the roll itself.
+    assert np.allclose(errors["sensor"], np.abs(np.rad2deg(rolls)), atol=1.0)
+
+
+def test_wrist_stabilisation_keeps_the_hands_on_the_forearm(clean_kinect, box_truth):
+    kinect = clean_kinect["azure-kinect"]
+    _, local = retarget(
+        kinect.positions, kinect.orientations, kinect.rig, box_truth.skeleton, "sensor"
+    )
+    hands = box_truth.skeleton.indices(["Bip01 L Hand", "Bip01 R Hand"])
+    assert np.allclose(local[:, hands], quat.IDENTITY)
+
+
+def test_shortest_arc_turns_u_onto_v_and_handles_opposites():
+    rng = np.random.default_rng(0)
+    u, v = rng.normal(size=(50, 3)), rng.normal(size=(50, 3))
+    v[0] = -u[0]
+    q = shortest_arc(u, v)
+    turned = quat.rotate(q, u)
+    unit = v / np.linalg.norm(v, axis=-1, keepdims=True)
+    assert np.allclose(turned / np.linalg.norm(turned, axis=-1, keepdims=True), unit, atol=1e-9)
