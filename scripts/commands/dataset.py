@@ -35,7 +35,6 @@ from scripts.cli_common import (
     user_errors,
 )
 
-EXECUTORS = ("local", "ray")
 DirArg = Annotated[Path, typer.Argument(help="A dataset folder (written by generate).")]
 
 
@@ -49,25 +48,29 @@ def register(app: typer.Typer) -> None:
     def generate(
         config: Annotated[Path, typer.Argument(help="Dataset config TOML.")],
         out: Annotated[Path, typer.Option(help="Dataset folder (resumed when it holds a run).")],
-        workers: Annotated[int, typer.Option(help="Worker processes (local executor).")] = 1,
+        workers: Annotated[
+            int, typer.Option(help="Shards made at once: processes (local) or Ray tasks.")
+        ] = 1,
         executor: Annotated[str, typer.Option(help="local (process pool) or ray.")] = "local",
+        address: Annotated[
+            str | None,
+            typer.Option(
+                help="Ray cluster to attach to (auto, HOST:PORT, ray://HOST:10001); "
+                "default: a new local Ray instance of --workers CPUs."
+            ),
+        ] = None,
         seed: Annotated[
             int | None, typer.Option("--seed", help="Override the config's seed.")
         ] = None,
         json_out: JsonOpt = None,
     ) -> None:
         """Generate (or resume) a sharded dataset: shards, then the manifest."""
-        from avatar_models.errors import AvatarsimError
         from scripts.dataset.config import load_config
+        from scripts.dataset.executors import check_executor
         from scripts.dataset.plan import plan_samples
         from scripts.dataset.runner import generate as run_generate
 
-        if executor not in EXECUTORS:
-            raise AvatarsimError(f"--executor must be one of {', '.join(EXECUTORS)}")
-        if executor == "ray":
-            raise AvatarsimError("--executor ray is not available yet; use --executor local")
-        if workers < 1:
-            raise AvatarsimError(f"--workers must be at least 1, got {workers}")
+        check_executor(executor, workers, address)
         check_outputs(json_out=json_out, out=out)
         cfg = load_config(config).with_seed(seed)
         plan_samples(cfg)  # a config whose plan fails (an empty mocap source) writes nothing
@@ -92,6 +95,8 @@ def register(app: typer.Typer) -> None:
                 workers,
                 on_start=started,
                 on_shard=lambda n: progress.advance(task, n),
+                executor=executor,
+                address=address,
             )
         rate = result.made_samples / max(result.seconds, 1e-9)
         payload = {

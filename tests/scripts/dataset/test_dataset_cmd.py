@@ -68,9 +68,16 @@ def test_unwritable_out_exits_2(tiny_config_path, tmp_path):
     assert "error:" in result.output
 
 
-def test_out_that_is_a_file_and_ray_exit_2(tiny_config_path, tmp_path):
+def test_out_that_is_a_file_and_bad_executors_exit_2(tiny_config_path, tmp_path):
     a_file = tmp_path / "file"
     a_file.write_text("x")
-    for extra in (["--out", str(a_file)], ["--out", str(tmp_path / "d"), "--executor", "ray"]):
+    out = ["--out", str(tmp_path / "d")]
+    for extra in (
+        ["--out", str(a_file)],
+        [*out, "--executor", "dask"],
+        [*out, "--address", "auto"],  # a Ray address without --executor ray
+        [*out, "--workers", "0"],
+    ):
         result = runner.invoke(app, ["dataset", "generate", str(tiny_config_path), *extra])
         assert result.exit_code == 2, result.output
+    assert not (tmp_path / "d").exists()
