@@ -1,8 +1,9 @@
-"""``avatarsim dataset generate|info|verify``: sharded synthetic datasets (scripts.dataset).
+"""``avatarsim dataset generate|info|verify|preview``: sharded synthetic datasets.
 
 ``generate CONFIG --out DIR`` writes WebDataset-style shards and a manifest, resuming a run
 of the same config and seed in ``DIR``; ``info DIR`` summarises a dataset; ``verify DIR``
-checks hashes, counts, completeness and splits (exit 1 when a check fails). Bad input (an
+checks hashes, counts, completeness and splits (exit 1 when a check fails); ``preview DIR``
+draws random samples with their ground-truth skeleton. Bad input (an
 unknown config key, an empty source, split fractions not summing to 1, an unwritable or
 foreign ``--out``) exits 2 before anything is written.
 """
@@ -40,7 +41,7 @@ DirArg = Annotated[Path, typer.Argument(help="A dataset folder (written by gener
 
 def register(app: typer.Typer) -> None:
     dataset = make_app()
-    dataset.info.help = "Sharded synthetic datasets: generate, info, verify."
+    dataset.info.help = "Sharded synthetic datasets: generate, info, verify, preview."
     app.add_typer(dataset, name="dataset")
 
     @dataset.command()
@@ -141,6 +142,35 @@ def register(app: typer.Typer) -> None:
         # Nothing here is random; the seed is accepted and recorded as every command's is.
         payload = {k: v for k, v in manifest.items() if k != "shards"}
         emit_json(json_out, payload | {"shards": len(manifest["shards"]), "seed": seed})
+
+    @dataset.command()
+    @user_errors
+    def preview(
+        path: DirArg,
+        out: Annotated[Path, typer.Option(help="The picture sheet to write (PNG).")] = Path(
+            "out/dataset-preview.png"
+        ),
+        samples: Annotated[int, typer.Option(help="Random samples on the sheet.")] = 12,
+        split: Annotated[
+            str | None, typer.Option(help="Only this split (train, val, test).")
+        ] = None,
+        seed: SeedOpt = 0,
+        json_out: JsonOpt = None,
+    ) -> None:
+        """A picture sheet of random samples with the ground-truth skeleton drawn on (the
+        fisheye camera that sees most of it, else a side view)."""
+        from avatar_models.errors import AvatarsimError
+        from scripts.dataset.config import SPLITS
+        from scripts.dataset.preview import preview_sheet
+
+        if samples < 1:
+            raise AvatarsimError(f"--samples must be at least 1, got {samples}")
+        if split is not None and split not in SPLITS:
+            raise AvatarsimError(f"--split must be one of {', '.join(SPLITS)}, got {split!r}")
+        check_outputs(json_out=json_out, files={"--out": out})
+        panels = preview_sheet(path, out, samples, seed, split)
+        console.print(escape(f"{out}: {len(panels)} samples"))
+        emit_json(json_out, {"out": str(out), "panels": panels, "seed": seed})
 
     @dataset.command()
     @user_errors
