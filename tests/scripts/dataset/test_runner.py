@@ -15,6 +15,7 @@ from scripts.dataset import runner as runner_module
 from scripts.dataset.config import load_config
 from scripts.dataset.manifest import DatasetError
 from scripts.dataset.runner import generate
+from scripts.dataset.shards import read_samples
 from scripts.dataset.verify import verify_dataset
 from tests.scripts.dataset.builders import TINY, tree_bytes, write_config
 
@@ -171,3 +172,40 @@ def test_a_mocap_dataset_split_by_clip_verifies(mocap_dir, tmp_path):
     assert held_out and not train & held_out
     assert all(g.startswith("clip:") for g in train | held_out)
     assert verify_dataset(tmp_path / "ds").passed
+
+
+def _bandai_subset(mocap_dir: Path, folder: Path, names: list[str]) -> Path:
+    """A Bandai dataset folder of a few clips: links to its ``cfg`` labels and to each clip
+    with its ``.json`` (the real files, read in place, not copied)."""
+    source = mocap_dir / "bandai" / "dataset-2"
+    (folder / "data").mkdir(parents=True)
+    (folder / "cfg").symlink_to(source / "cfg")
+    for name in names:
+        for ext in (".bvh", ".json"):
+            (folder / "data" / f"{name}{ext}").symlink_to(source / "data" / f"{name}{ext}")
+    return folder
+
+
+@pytest.mark.mocap
+@pytest.mark.parametrize("dataset", ["dataset-1", "dataset-2"])
+def test_a_bandai_dataset_split_by_clip_verifies(mocap_dir, tmp_path, dataset):
+    """Three real clips of each Bandai set (a foreign rig: retargeted onto the humanoid),
+    one per split; dataset-1 through its own folder and an activity filter (one take each
+    of kick, respond and dance-short), dataset-2 through a folder of three of its clips."""
+    if dataset == "dataset-1":
+        path = mocap_dir / "bandai" / "dataset-1"
+        activities = ["kick", "respond", "dance-short"]
+    else:
+        names = [f"dataset-2_{c}_normal_001" for c in ("walk", "run", "wave-left-hand")]
+        path, activities = _bandai_subset(mocap_dir, tmp_path / "d2", names), []
+    source = {"kind": "mocap", "path": str(path), "activities": activities}
+    # Half-second windows: retargeting (IK per frame) is most of a Bandai sample's time.
+    window = {"seconds": 0.5, "fps": 30.0}
+    config = load_config(write_config(tmp_path / "c.toml", sources=[source], window=window))
+    result = generate(config, tmp_path / "ds")
+    counts = result.manifest["counts"]
+    assert result.samples == 3 and all(counts[s]["samples"] == 1 for s in counts)
+    assert result.frames == 3 * 16  # 0.5 s at 30 Hz, both ends: every clip is longer
+    assert verify_dataset(tmp_path / "ds").passed
+    sample = next(read_samples(tmp_path / "ds" / result.manifest["shards"][0]["file"]))[1]
+    assert sample["json"]["body"]["retargeted"] and sample["json"]["provenance"]["clip"]
