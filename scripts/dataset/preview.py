@@ -1,7 +1,8 @@
 """``dataset preview``: a picture sheet of random samples with the ground-truth skeleton drawn.
 
 Each panel is one sample at one frame, both drawn from ``seed``. With a fisheye channel it
-shows the controller camera that sees the most joints then: the image frame, the body17
+shows the controller camera that sees the most joints then: its rendered image when the
+sample has images (at a rendered frame), the image frame, the body17
 keypoints (filled where ``in_view``, hollow where not) and the skeleton between them, so a
 wrong projection, a mirrored camera or a swapped side shows at a glance. Without one it
 shows the 3D ground truth from the side (X forward, Z up). The title names the key,
@@ -18,6 +19,7 @@ import numpy as np
 
 from avatar_models.body17 import INDEX
 from avatar_models.fileio import write_atomic
+from scripts.dataset.channels import IMAGE_SUFFIX
 from scripts.dataset.manifest import DatasetError, read_manifest
 from scripts.dataset.shards import read_samples
 
@@ -77,17 +79,32 @@ def _draw_skeleton(ax: Any, points: np.ndarray, shown: np.ndarray) -> None:
     ax.scatter(*points[~shown].T, s=12, facecolors="none", edgecolors="k", zorder=3)
 
 
+def _image_entry(meta: dict, camera: str, n: int) -> str | None:
+    """The entry name of camera ``camera``'s ``n``-th rendered image, if images were made."""
+    images = meta["channels"].get("fisheye_images")
+    if images is None:
+        return None
+    suffix = IMAGE_SUFFIX[images["format"]]
+    return f"fisheye_image.{camera.replace('/', '-')}.{n:04d}{suffix}"
+
+
 def _panel(ax: Any, key: str, sample: dict, rng: np.random.Generator) -> dict[str, Any]:
     from matplotlib.patches import Rectangle
 
     meta = sample["json"]
     title = f"{key} {meta.get('activity') or '-'} ({meta['split']})"
     if "fisheye_uv" in sample:
-        frame = int(rng.integers(sample["fisheye_uv"].shape[0]))
+        # A frame with images where they were rendered (every image_stride-th).
+        frames = sample.get("fisheye_image_frames", np.arange(sample["fisheye_uv"].shape[0]))
+        n = int(rng.integers(len(frames)))
+        frame = int(frames[n])
         seen = sample["fisheye_in_view"][frame]  # (C, 17)
         camera = int(np.argmax(seen.sum(axis=1)))
         model = meta["channels"]["fisheye"]["model"]
         name = meta["channels"]["fisheye"]["cameras"][camera]
+        image = sample.get(_image_entry(meta, name, n))
+        if image is not None:  # drawn at the keypoints' full-resolution pixel scale
+            ax.imshow(image, extent=(0, model["width"], model["height"], 0))
         frame_box = Rectangle((0, 0), model["width"], model["height"], fill=False, ls="--")
         ax.add_patch(frame_box)
         _draw_skeleton(ax, sample["fisheye_uv"][frame, camera], seen[camera])

@@ -27,6 +27,11 @@ def test_tiny_config_loads_with_defaults(tmp_path):
         ({"splits": {"train": 0.9, "holdout": 0.1}}, "unknown split"),
         ({"devices": [{"name": "a", "kinect": "kinect-v3"}]}, "kinect must be"),
         ({"samples_per_shard": 0}, "samples_per_shard"),
+        ({"devices": [{"name": "a", "fisheye_images": "gif"}]}, "fisheye_images must be"),
+        ({"devices": [{"name": "a", "fisheye": False, "fisheye_images": "png"}]}, "needs fish"),
+        ({"devices": [{"name": "a", "kinect_depth": True}]}, "needs a kinect"),
+        ({"devices": [{"name": "a", "image_stride": 0}]}, "image_stride"),
+        ({"devices": [{"name": "a", "image_scale": 10.0}]}, "image_scale"),
     ],
 )
 def test_bad_configs_are_config_errors(tmp_path, changes, reason):
