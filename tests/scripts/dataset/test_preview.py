@@ -7,8 +7,11 @@ from PIL import Image
 from typer.testing import CliRunner
 
 from scripts.cli import app
+from scripts.dataset.config import load_config
 from scripts.dataset.manifest import read_manifest
 from scripts.dataset.preview import SKELETON_LINES, preview_sheet
+from scripts.dataset.runner import generate
+from tests.scripts.dataset.builders import write_config
 
 runner = CliRunner()
 
@@ -43,3 +46,17 @@ def test_preview_cli_writes_the_sheet_and_rejects_bad_input(tiny_dataset, tmp_pa
     empty = tmp_path / "empty"
     empty.mkdir()
     assert runner.invoke(app, ["dataset", "preview", str(empty)]).exit_code == 2
+
+
+def test_preview_draws_the_rendered_image_under_the_skeleton(tmp_path):
+    devices = [{"name": "img", "fisheye_images": "png", "image_scale": 0.25}]
+    changes = {"window": {"seconds": 0.2, "fps": 30.0}, "devices": devices}
+    sources = [{"kind": "builtin", "activities": ["wave"], "subjects": 3}]
+    config = load_config(write_config(tmp_path / "c.toml", sources=sources, **changes))
+    generate(config, tmp_path / "ds")
+    panels = preview_sheet(tmp_path / "ds", tmp_path / "a.png", samples=3, seed=0)
+    assert all(p["frame"] % 3 == 0 for p in panels)  # frames with images (every 3rd)
+    image = np.asarray(Image.open(tmp_path / "a.png").convert("L"))
+    # The images fill their frames: 34 % of the sheet is not white here, 7 % of a
+    # keypoints-only sheet of 8 panels (frame boxes, skeletons and titles).
+    assert (image < 250).mean() > 0.2
