@@ -1,12 +1,15 @@
 from __future__ import annotations
 
+import errno
 import json
+import os
 import shutil
 
 import pytest
 from typer.testing import CliRunner
 
 from scripts.cli import app
+from scripts.dataset import runner as runner_module
 from tests.scripts.dataset.builders import tree_bytes, write_config
 
 runner = CliRunner()
@@ -81,3 +84,15 @@ def test_out_that_is_a_file_and_bad_executors_exit_2(tiny_config_path, tmp_path)
         result = runner.invoke(app, ["dataset", "generate", str(tiny_config_path), *extra])
         assert result.exit_code == 2, result.output
     assert not (tmp_path / "d").exists()
+
+
+def test_a_full_disk_exits_2_and_says_how_to_resume(tiny_config_path, tmp_path, monkeypatch):
+    def no_space(path, data):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
+
+    monkeypatch.setattr(runner_module, "write_atomic", no_space)
+    out = tmp_path / "ds"
+    result = runner.invoke(app, ["dataset", "generate", str(tiny_config_path), "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    assert "No space left" in result.output and "resume" in result.output
+    assert not list((out / "shards").iterdir()) and not (out / "manifest.json").exists()
