@@ -13,7 +13,7 @@ from __future__ import annotations
 import hashlib
 import json
 import tomllib
-from dataclasses import asdict, dataclass, field, fields, replace
+from dataclasses import MISSING, asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -121,9 +121,25 @@ class DatasetConfig:
 
 
 def config_hash(config: DatasetConfig) -> str:
-    """sha256 (hex) of the normalised config, keys sorted."""
-    text = json.dumps(config.as_dict(), sort_keys=True, separators=(",", ":"))
+    """sha256 (hex) of the normalised config, keys sorted, each source's and device set's
+    keys at their defaults left out: a key added later whose default keeps the old output
+    (a new channel, off unless asked for) leaves the hash, and so resuming and verifying
+    datasets made before it, unchanged."""
+    data = config.as_dict()
+    for key, table in (("sources", config.sources), ("devices", config.devices)):
+        data[key] = [_without_defaults(t) for t in table]
+    text = json.dumps(data, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _without_defaults(table: Any) -> dict[str, Any]:
+    """The dataclass ``table`` as JSON data, fields equal to their defaults left out."""
+    values = json.loads(json.dumps(asdict(table)))
+    return {
+        f.name: values[f.name]
+        for f in fields(table)
+        if f.default is MISSING or getattr(table, f.name) != f.default
+    }
 
 
 def load_config(path: str | Path) -> DatasetConfig:
