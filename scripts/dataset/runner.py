@@ -24,7 +24,7 @@ from typing import Any
 
 from avatar_models.fileio import write_atomic, write_json
 from scripts.dataset.config import DatasetConfig, config_hash
-from scripts.dataset.executors import run
+from scripts.dataset.executors import check_executor, run
 from scripts.dataset.manifest import (
     SHARD_DIR,
     STATE_FILE,
@@ -169,6 +169,7 @@ def generate(
         ExecutorError: the executor cannot run.
     """
     start = time.perf_counter()
+    check_executor(executor, workers, address)  # before anything is written
     shards = plan_shards(config, plan_samples(config))
     prepare(root, config)
     sidecars = {s.name: done_sidecar(root, s.name) for s in shards}

@@ -13,6 +13,7 @@ import pytest
 
 from scripts.dataset import runner as runner_module
 from scripts.dataset.config import load_config
+from scripts.dataset.executors import ExecutorError
 from scripts.dataset.manifest import DatasetError
 from scripts.dataset.runner import generate
 from scripts.dataset.shards import read_samples
@@ -62,6 +63,12 @@ def test_a_full_disk_stops_cleanly_and_the_next_run_resumes(
     monkeypatch.setattr(runner_module, "write_atomic", real_write)
     assert generate(config, root).made == 3
     assert tree_bytes(root) == tree_bytes(tiny_dataset)
+
+
+def test_a_bad_executor_writes_nothing(tiny_config_path, tmp_path):
+    with pytest.raises(ExecutorError, match="--address"):
+        generate(load_config(tiny_config_path), tmp_path / "ds", address="auto")
+    assert not (tmp_path / "ds").exists()
 
 
 def test_resume_remakes_only_what_is_missing_or_wrong(tiny_dataset, tiny_config_path, tmp_path):
