@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy.spatial.transform import Rotation, Slerp
+from scipy.spatial.transform import Rotation
 
 from avatar_models import quat
 from avatar_models.errors import MotionValueError
@@ -34,12 +34,50 @@ def check_fps(fps: float, what: str = "fps") -> None:
         raise MotionValueError(f"{what} must be {lo:g}-{hi:g} frames per second, got {fps!r}")
 
 
-def _depth_levels(parents: np.ndarray) -> list[np.ndarray]:
-    """Joint indices grouped by tree depth (root excluded), for level-parallel FK."""
+def _depth_levels(parents: np.ndarray, needed: np.ndarray) -> list[np.ndarray]:
+    """The ``needed (J,)`` joints grouped by tree depth (root excluded), for level-parallel
+    FK."""
     depth = np.zeros(len(parents), dtype=np.int64)
     for j in range(1, len(parents)):
         depth[j] = depth[parents[j]] + 1
-    return [np.flatnonzero(depth == d) for d in range(1, int(depth.max(initial=0)) + 1)]
+    levels = range(1, int(depth.max(initial=0)) + 1)
+    return [level for d in levels if (level := np.flatnonzero((depth == d) & needed)).size]
+
+
+def forward_kinematics(
+    skeleton: Skeleton,
+    root_pos: np.ndarray,
+    local: np.ndarray,
+    joints: Sequence[int] | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Global positions ``(T, J, 3)`` and rotations ``(T, J, 3, 3)`` from ``root_pos (T, 3)``
+    and local rotation matrices ``local (T, J, 3, 3)``.
+
+    Joints at the same tree depth are composed together, so the Python loop runs over depth
+    levels (about 10), not frames or joints. ``joints`` limits the work to those joints and
+    their ancestors (the others are left undefined): a caller that needs a few joints of a
+    matrix pose (the generator's IK, its centre of mass) skips the rest and the round trip
+    through quaternions.
+    """
+    parents = skeleton.parents
+    needed = np.zeros(skeleton.n_joints, dtype=bool)
+    if joints is None:
+        needed[:] = True
+    for j in () if joints is None else joints:
+        while j >= 0 and not needed[j]:
+            needed[j] = True
+            j = parents[j]
+    glob = np.empty_like(local)
+    pos = np.empty((local.shape[0], skeleton.n_joints, 3))
+    glob[:, 0] = local[:, 0]
+    pos[:, 0] = root_pos
+    for level in _depth_levels(parents, needed):
+        par = parents[level]
+        glob[:, level] = glob[:, par] @ local[:, level]
+        pos[:, level] = pos[:, par] + np.einsum(
+            "tjab,jb->tja", glob[:, par], skeleton.offsets[level]
+        )
+    return pos, glob
 
 
 @dataclass(frozen=True, eq=False)
@@ -110,25 +148,11 @@ class Motion:
 
     # -- forward kinematics ---------------------------------------------------------------
     def fk(self) -> tuple[np.ndarray, np.ndarray]:
-        """Global positions ``(T, J, 3)`` and rotation matrices ``(T, J, 3, 3)``, cached.
-
-        Joints at the same tree depth are composed together, so the Python loop runs over
-        depth levels (about 10), not frames or joints.
-        """
+        """Global positions ``(T, J, 3)`` and rotation matrices ``(T, J, 3, 3)``, cached
+        (:func:`forward_kinematics`)."""
         if self._fk is None:  # type: ignore[attr-defined]
-            sk = self.skeleton
             local = quat.to_matrix(self.local_rot)
-            glob = np.empty_like(local)
-            pos = np.empty((self.n_frames, sk.n_joints, 3))
-            glob[:, 0] = local[:, 0]
-            pos[:, 0] = self.root_pos
-            for level in _depth_levels(sk.parents):
-                par = sk.parents[level]
-                glob[:, level] = glob[:, par] @ local[:, level]
-                pos[:, level] = pos[:, par] + np.einsum(
-                    "tjab,jb->tja", glob[:, par], sk.offsets[level]
-                )
-            object.__setattr__(self, "_fk", (pos, glob))
+            object.__setattr__(self, "_fk", forward_kinematics(self.skeleton, self.root_pos, local))
         return self._fk  # type: ignore[attr-defined]
 
     def global_positions(self) -> np.ndarray:
@@ -189,7 +213,8 @@ class Motion:
     def sample(self, times: np.ndarray) -> Motion:
         """Motion evaluated at ``times (N,)`` seconds (clamped to the clip), at this fps.
 
-        Root translation is interpolated linearly, rotations by slerp (scipy), per joint.
+        Root translation is interpolated linearly, rotations by slerp along the shortest
+        arc (:func:`avatar_models.quat.power`), all joints at once.
         """
         times = np.clip(np.asarray(times, dtype=float), 0.0, self.duration_s)
         if self.n_frames == 1:
@@ -199,10 +224,12 @@ class Motion:
             )
         t = self.times
         root = np.stack([np.interp(times, t, self.root_pos[:, k]) for k in range(3)], axis=1)
-        rot = np.empty((times.size, self.skeleton.n_joints, 4))
-        for j in range(self.skeleton.n_joints):
-            slerp = Slerp(t, quat.to_scipy(self.local_rot[:, j]))
-            rot[:, j] = quat.from_scipy(slerp(times))
+        key = np.clip(np.searchsorted(t, times, side="right") - 1, 0, t.size - 2)  # (N,)
+        alpha = (times - t[key]) / (t[key + 1] - t[key])  # (N,) in [0, 1]
+        start, end = self.local_rot[key], self.local_rot[key + 1]  # (N, J, 4)
+        step = quat.mul(quat.conj(start), end)
+        step /= np.linalg.norm(step, axis=-1, keepdims=True)
+        rot = quat.mul(start, quat.power(step, alpha[:, None]))
         return self.replace(root_pos=root, local_rot=rot)
 
     def resample(self, fps: float) -> Motion:

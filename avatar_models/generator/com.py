@@ -17,8 +17,8 @@ from scipy.linalg import solve_banded
 
 from avatar_models.body import build_body
 from avatar_models.generator.bounce import GRAVITY_M_S2
-from avatar_models.generator.plan import Plan, Scene, realise
-from avatar_models.motion import Motion
+from avatar_models.generator.plan import Plan, Scene, realise_local
+from avatar_models.motion import Motion, forward_kinematics
 from avatar_models.skeleton import Skeleton
 
 
@@ -37,7 +37,11 @@ class MassModel:
 
     def centre_of_mass(self, motion: Motion) -> np.ndarray:
         """``(T, 3)`` world centre of mass of ``motion`` (on the skeleton this was built for)."""
-        pos, rot = motion.fk()
+        return self.centre_of_mass_fk(*motion.fk())
+
+    def centre_of_mass_fk(self, pos: np.ndarray, rot: np.ndarray) -> np.ndarray:
+        """``(T, 3)`` world centre of mass of a pose given by its forward kinematics: joint
+        positions ``(T, J, 3)`` and rotations ``(T, J, 3, 3)`` (only ``joint``'s are read)."""
         points = pos[:, self.joint] + np.einsum("tsab,sb->tsa", rot[:, self.joint], self.local)
         return np.einsum("tsa,s->ta", points, self.mass / self.mass.sum())
 
@@ -53,8 +57,12 @@ def _mass_model(skeleton: Skeleton) -> MassModel:
 
 
 def plan_centre_of_mass(scene: Scene, plan: Plan) -> np.ndarray:
-    """``(T, 3)`` centre of mass of the realised ``plan``."""
-    return MassModel.of(scene.skeleton).centre_of_mass(realise(scene, plan))
+    """``(T, 3)`` centre of mass of the realised ``plan``, from its rotation matrices and
+    only the segments' joints (the planning loops call this a dozen times a clip)."""
+    masses = MassModel.of(scene.skeleton)
+    local = realise_local(scene, plan)
+    fk = forward_kinematics(scene.skeleton, plan.root_pos, local, masses.joint.tolist())
+    return masses.centre_of_mass_fk(*fk)
 
 
 def lipm_centre_of_mass(zmp: np.ndarray, height: float, fps: float) -> np.ndarray:

@@ -17,7 +17,7 @@ import numpy as np
 from avatar_models import quat
 from avatar_models.generator.ik import axis_rotation, scale_rotation, twist_about, two_bone_ik
 from avatar_models.generator.subject import Style, Subject
-from avatar_models.motion import Motion
+from avatar_models.motion import Motion, forward_kinematics
 from avatar_models.skeleton import Skeleton
 
 SIDES = ("L", "R")
@@ -134,11 +134,17 @@ def _finger_rotations(scene: Scene, fist: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def _motion(scene: Scene, plan: Plan, local: np.ndarray) -> Motion:
-    return Motion(scene.skeleton, scene.fps, plan.root_pos, quat.from_matrix(local))
+    return Motion(scene.skeleton, scene.fps, plan.root_pos, quat.from_matrix(local, True))
 
 
 def realise(scene: Scene, plan: Plan) -> Motion:
     """The plan as a motion on ``scene.skeleton`` (``meta`` is left for the caller)."""
+    return _motion(scene, plan, realise_local(scene, plan))
+
+
+def realise_local(scene: Scene, plan: Plan) -> np.ndarray:
+    """The plan's local joint rotations ``(T, J, 3, 3)`` on ``scene.skeleton`` (what
+    :func:`realise` turns into a motion)."""
     sk = scene.skeleton
     idx = sk.index
     local = np.broadcast_to(np.eye(3), (scene.n_frames, sk.n_joints, 3, 3)).copy()
@@ -155,7 +161,7 @@ def realise(scene: Scene, plan: Plan) -> Motion:
     # Head stabilisation: neck and head together turn the upper trunk's frame into the gaze;
     # the neck takes 40 %. Clavicles hang from the neck in a Biped, so they undo the neck's
     # share to keep the shoulders with the chest.
-    glob = _motion(scene, plan, local).fk()[1]
+    glob = forward_kinematics(sk, plan.root_pos, local, [idx("Bip01 Spine2")])[1]
     needed = np.swapaxes(glob[:, idx("Bip01 Spine2")], -1, -2) @ plan.head
     neck = scale_rotation(needed, 0.4)
     local[:, idx("Bip01 Neck")] = neck
@@ -164,10 +170,11 @@ def realise(scene: Scene, plan: Plan) -> Motion:
         c = idx(f"Bip01 {side} Clavicle")
         local[:, c] = np.swapaxes(neck, -1, -2) @ local[:, c]
 
-    pos, glob = _motion(scene, plan, local).fk()
     leg, arm = ("Thigh", "Calf", "Foot"), ("UpperArm", "Forearm", "Hand")
     limbs = [(s, t, leg, KNEE_HINGE) for s, t in plan.legs.items()]
     limbs += [(s, t, arm, ELBOW_HINGE[s]) for s, t in plan.arms.items()]
+    roots = [idx(f"Bip01 {side} {joints[0]}") for side, _, joints, _ in limbs]
+    pos, glob = forward_kinematics(sk, plan.root_pos, local, roots)
     for side, target, joints, hinge in limbs:
         u, m, e = (idx(f"Bip01 {side} {j}") for j in joints)
         upper_local, middle_local, upper_world = two_bone_ik(
@@ -189,4 +196,4 @@ def realise(scene: Scene, plan: Plan) -> Motion:
                 end_local = np.swapaxes(twist, -1, -2) @ end_local
             local[:, e] = end_local
         local[:, u], local[:, m] = upper_local, middle_local
-    return _motion(scene, plan, local)
+    return local

@@ -23,6 +23,7 @@ BENCHMARKS: dict[str, str] = {
     "movebox": "movebox",
     "control": "control",
     "suite": "suite",
+    "dataset": "dataset",
 }
 
 

@@ -1,8 +1,9 @@
-"""``avatarsim dataset generate|info|verify``: sharded synthetic datasets (scripts.dataset).
+"""``avatarsim dataset generate|info|verify|preview``: sharded synthetic datasets.
 
 ``generate CONFIG --out DIR`` writes WebDataset-style shards and a manifest, resuming a run
 of the same config and seed in ``DIR``; ``info DIR`` summarises a dataset; ``verify DIR``
-checks hashes, counts, completeness and splits (exit 1 when a check fails). Bad input (an
+checks hashes, counts, completeness and splits (exit 1 when a check fails); ``preview DIR``
+draws random samples with their ground-truth skeleton. Bad input (an
 unknown config key, an empty source, split fractions not summing to 1, an unwritable or
 foreign ``--out``) exits 2 before anything is written.
 """
@@ -35,13 +36,12 @@ from scripts.cli_common import (
     user_errors,
 )
 
-EXECUTORS = ("local", "ray")
 DirArg = Annotated[Path, typer.Argument(help="A dataset folder (written by generate).")]
 
 
 def register(app: typer.Typer) -> None:
     dataset = make_app()
-    dataset.info.help = "Sharded synthetic datasets: generate, info, verify."
+    dataset.info.help = "Sharded synthetic datasets: generate, info, verify, preview."
     app.add_typer(dataset, name="dataset")
 
     @dataset.command()
@@ -49,25 +49,29 @@ def register(app: typer.Typer) -> None:
     def generate(
         config: Annotated[Path, typer.Argument(help="Dataset config TOML.")],
         out: Annotated[Path, typer.Option(help="Dataset folder (resumed when it holds a run).")],
-        workers: Annotated[int, typer.Option(help="Worker processes (local executor).")] = 1,
+        workers: Annotated[
+            int, typer.Option(help="Shards made at once: processes (local) or Ray tasks.")
+        ] = 1,
         executor: Annotated[str, typer.Option(help="local (process pool) or ray.")] = "local",
+        address: Annotated[
+            str | None,
+            typer.Option(
+                help="Ray cluster to attach to (auto, HOST:PORT, ray://HOST:10001); "
+                "default: a new local Ray instance of --workers CPUs."
+            ),
+        ] = None,
         seed: Annotated[
             int | None, typer.Option("--seed", help="Override the config's seed.")
         ] = None,
         json_out: JsonOpt = None,
     ) -> None:
         """Generate (or resume) a sharded dataset: shards, then the manifest."""
-        from avatar_models.errors import AvatarsimError
         from scripts.dataset.config import load_config
+        from scripts.dataset.executors import check_executor
         from scripts.dataset.plan import plan_samples
         from scripts.dataset.runner import generate as run_generate
 
-        if executor not in EXECUTORS:
-            raise AvatarsimError(f"--executor must be one of {', '.join(EXECUTORS)}")
-        if executor == "ray":
-            raise AvatarsimError("--executor ray is not available yet; use --executor local")
-        if workers < 1:
-            raise AvatarsimError(f"--workers must be at least 1, got {workers}")
+        check_executor(executor, workers, address)
         check_outputs(json_out=json_out, out=out)
         cfg = load_config(config).with_seed(seed)
         plan_samples(cfg)  # a config whose plan fails (an empty mocap source) writes nothing
@@ -92,6 +96,8 @@ def register(app: typer.Typer) -> None:
                 workers,
                 on_start=started,
                 on_shard=lambda n: progress.advance(task, n),
+                executor=executor,
+                address=address,
             )
         rate = result.made_samples / max(result.seconds, 1e-9)
         payload = {
@@ -136,6 +142,35 @@ def register(app: typer.Typer) -> None:
         # Nothing here is random; the seed is accepted and recorded as every command's is.
         payload = {k: v for k, v in manifest.items() if k != "shards"}
         emit_json(json_out, payload | {"shards": len(manifest["shards"]), "seed": seed})
+
+    @dataset.command()
+    @user_errors
+    def preview(
+        path: DirArg,
+        out: Annotated[Path, typer.Option(help="The picture sheet to write (PNG).")] = Path(
+            "out/dataset-preview.png"
+        ),
+        samples: Annotated[int, typer.Option(help="Random samples on the sheet.")] = 12,
+        split: Annotated[
+            str | None, typer.Option(help="Only this split (train, val, test).")
+        ] = None,
+        seed: SeedOpt = 0,
+        json_out: JsonOpt = None,
+    ) -> None:
+        """A picture sheet of random samples with the ground-truth skeleton drawn on (the
+        fisheye camera that sees most of it, else a side view)."""
+        from avatar_models.errors import AvatarsimError
+        from scripts.dataset.config import SPLITS
+        from scripts.dataset.preview import preview_sheet
+
+        if samples < 1:
+            raise AvatarsimError(f"--samples must be at least 1, got {samples}")
+        if split is not None and split not in SPLITS:
+            raise AvatarsimError(f"--split must be one of {', '.join(SPLITS)}, got {split!r}")
+        check_outputs(json_out=json_out, files={"--out": out})
+        panels = preview_sheet(path, out, samples, seed, split)
+        console.print(escape(f"{out}: {len(panels)} samples"))
+        emit_json(json_out, {"out": str(out), "panels": panels, "seed": seed})
 
     @dataset.command()
     @user_errors

@@ -1,4 +1,4 @@
-"""Synthetic datasets: ``avatarsim dataset generate|info|verify`` (issue 11, first slice).
+"""Synthetic datasets: ``avatarsim dataset generate|info|verify|preview`` (issue 11).
 
 One concept per module:
 
@@ -9,7 +9,9 @@ One concept per module:
 - :mod:`.sample`: one sample's arrays and JSON (ground truth plus its channels);
 - :mod:`.shards`: WebDataset-layout tar shards, byte-deterministic;
 - :mod:`.manifest`: per-shard sidecars and the dataset manifest;
-- :mod:`.runner`: the local process pool, atomic shard writes, resume, progress;
+- :mod:`.executors`: where shards are made (a local process pool or Ray);
+- :mod:`.runner`: shards made by an executor, written atomically here, resume, progress;
 - :mod:`.verify`: hashes, counts, nothing lost or duplicated, no split leak;
-- :mod:`.torch_dataset`: a torch ``IterableDataset`` over the shards.
+- :mod:`.torch_dataset`: a torch ``IterableDataset`` over the shards;
+- :mod:`.preview`: a picture sheet of random samples with their ground-truth skeleton.
 """

@@ -9,25 +9,32 @@ whose motion and body every channel shares, and a channel seed.
   but no image is rendered, so ``in_view`` means "in the image and the lens not inside the
   body" and is NOT occlusion-tested (a joint behind the user's own arm counts as in view);
   the rendered visibility of :func:`render_cams.fisheye.keypoints.visibility` needs a range
-  image per frame (images are a later slice). ``fisheye_uv`` and ``fisheye_conf`` are what
-  a 2D detector reports (:class:`render_cams.fisheye.detector.KeypointDetector`, its default
-  error model, seeded): the exact projections are ``fisheye_uv_projected``.
-- :func:`kinect_channel`: the Kinect skeleton with tracking states (no depth is rendered).
+  image per frame, which a keypoints-only dataset does not render. ``fisheye_uv`` and
+  ``fisheye_conf`` are what a 2D detector reports
+  (:class:`render_cams.fisheye.detector.KeypointDetector`, its default error model,
+  seeded): the exact projections are ``fisheye_uv_projected``.
+- :func:`kinect_channel`: the Kinect skeleton with tracking states.
+- :func:`fisheye_image_channel` and the Kinect's depth (:func:`kinect_channel`): rendered
+  images of every ``image_stride``-th camera frame, one encoded file per camera and frame
+  (JPEG or PNG RGB; 16-bit PNG depth in millimetres), as WebDataset stores images; their
+  frame indices and the cameras' intrinsics and extrinsics are in arrays and JSON beside
+  them.
 - :func:`physics_channel`: per-frame foot contact, floor penetration and foot skate from
   :func:`sim.plausibility.check_humanoid`.
 """
 
 from __future__ import annotations
 
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from typing import Any
 
+import cv2
 import numpy as np
 
 from avatar_models.rigs import body17_positions
 from render_cams.device import motion_at_rate
 from render_cams.fisheye.detector import KeypointDetector
-from render_cams.fisheye.device import FisheyeRig
+from render_cams.fisheye.device import CAMERA_RATE_HZ, FisheyeRig
 from render_cams.fisheye.keypoints import confidence, project_joints, world_to_camera
 from render_cams.fisheye.rig import camera_poses, controller_cameras, inside_body
 from render_cams.kinect import Kinect
@@ -37,8 +44,10 @@ from scripts.stages.devices import REALISTIC_NOISE
 from sim.humanoid import Humanoid
 from sim.plausibility import check_humanoid
 
-Channel = tuple[dict[str, np.ndarray], dict[str, Any]]
+Channel = tuple[dict[str, np.ndarray | bytes], dict[str, Any]]  # bytes: an encoded image
 CM = 0.01  # the checks report centimetres; datasets store metres
+IMAGE_SUFFIX = {"jpeg": ".jpg", "png": ".png"}
+IMAGE_PARAMS = {"jpeg": [cv2.IMWRITE_JPEG_QUALITY, 90], "png": [cv2.IMWRITE_PNG_COMPRESSION, 3]}
 
 
 def f32(values: np.ndarray) -> np.ndarray:
@@ -111,18 +120,65 @@ def fisheye_channel(humanoid: Humanoid, seed: int) -> Channel:
     return arrays, meta
 
 
-def kinect_channel(humanoid: Humanoid, sensor: str, seed: int) -> Channel:
+def kinect_channel(humanoid: Humanoid, sensor: str, seed: int, depth_stride: int = 0) -> Channel:
     """``kinect_pos`` (Tk, J, 3) world metres (meaningless where not tracked),
     ``kinect_quat`` (Tk, J, 4) wxyz, ``kinect_state`` (Tk, J) int8 (0 not tracked,
-    1 inferred, 2 tracked); sensor intrinsics and pose in the JSON."""
+    1 inferred, 2 tracked); sensor intrinsics and pose in the JSON. With ``depth_stride``,
+    also the depth of every ``depth_stride``-th frame: ``kinect_depth_frames`` (N,) int
+    frame indices into Tk and ``kinect_depth.{n:04d}.png`` (H, W) uint16 millimetres (0: no
+    reading), rendered with the skeleton's seed."""
     recording = Kinect(sensor).sample(humanoid.motion, seed=seed, body=humanoid.body)
     skeleton = recording.skeleton
-    arrays = {
+    arrays: dict[str, Any] = {
         "kinect_pos": f32(skeleton.positions),
         "kinect_quat": f32(skeleton.orientations),
         "kinect_state": np.ascontiguousarray(skeleton.states, dtype=np.int8),
     }
-    return arrays, recording.record
+    meta = dict(recording.record)
+    if depth_stride:
+        frames = recording.frames
+        strided = replace(frames, motion=frames.motion[::depth_stride])
+        arrays["kinect_depth_frames"] = np.arange(len(strided), dtype=np.int32) * depth_stride
+        for n, frame in enumerate(strided):
+            arrays[f"kinect_depth.{n:04d}.png"] = encode_image(frame.depth_mm, "png")
+        meta["depth"] = {"format": "png16", "unit": "mm", "stride": depth_stride}
+    return arrays, meta
+
+
+def encode_image(image: np.ndarray, fmt: str) -> bytes:
+    """``image`` (H, W, 3) uint8 RGB or (H, W) uint16 as a ``"jpeg"`` or ``"png"`` file
+    (OpenCV's encoders: the same pixels always give the same bytes)."""
+    pixels = image[..., ::-1] if image.ndim == 3 else image  # OpenCV writes BGR
+    ok, data = cv2.imencode(IMAGE_SUFFIX[fmt], np.ascontiguousarray(pixels), IMAGE_PARAMS[fmt])
+    if not ok:
+        raise ValueError(f"cannot encode a {image.dtype} {image.shape} image as {fmt}")
+    return data.tobytes()
+
+
+def fisheye_image_channel(humanoid: Humanoid, devices: DeviceSetConfig, seed: int) -> Channel:
+    """``fisheye_image_frames`` (N,) int camera-frame indices (into ``fisheye_uv``'s Tc) and
+    ``fisheye_image.{camera}.{n:04d}.jpg|png`` (h, w, 3) RGB per camera and rendered frame,
+    as :class:`~render_cams.fisheye.device.FisheyeRig` records them (bad frames injected,
+    dark when the lens is covered) at ``image_scale``; the scaled intrinsics in the JSON."""
+    rig = FisheyeRig(scale=devices.image_scale, rate_hz=CAMERA_RATE_HZ / devices.image_stride)
+    recording = rig.sample(humanoid.motion, seed=seed, body=humanoid.body)
+    n_frames = recording.images.shape[1]
+    arrays: dict[str, Any] = {
+        "fisheye_image_frames": np.arange(n_frames, dtype=np.int32) * devices.image_stride
+    }
+    for c, name in enumerate(recording.names):
+        for n in range(n_frames):
+            entry = f"fisheye_image.{name}.{n:04d}{IMAGE_SUFFIX[devices.fisheye_images]}"
+            arrays[entry] = encode_image(recording.images[c, n], devices.fisheye_images)
+    meta = {
+        "format": devices.fisheye_images,
+        "cameras": list(recording.names),
+        "stride": devices.image_stride,
+        "model": recording.model.as_dict(),
+        "bad_frames": recording.summary["bad_frames"],
+        "seed": seed,
+    }
+    return arrays, meta
 
 
 def physics_channel(humanoid: Humanoid) -> Channel:

@@ -13,16 +13,18 @@ from __future__ import annotations
 import hashlib
 import json
 import tomllib
-from dataclasses import asdict, dataclass, field, fields, replace
+from dataclasses import MISSING, asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
 from avatar_models.errors import AvatarsimError
 from avatar_models.generator import ACTIVITIES
+from render_cams.fisheye.device import SCALE_RANGE
 
 SPLITS = ("train", "val", "test")
 VR_NOISE = ("none", "realistic")
 KINECT_SENSORS = ("none", "kinect-v2", "azure-kinect")
+IMAGE_FORMATS = ("none", "jpeg", "png")
 MOCAP_SPLIT_BY = ("clip", "performer")
 SPLIT_TOLERANCE = 1e-6
 
@@ -70,8 +72,16 @@ class DeviceSetConfig:
         name: the device set's name (part of every sample key).
         vr: headset + controllers at 90 Hz; ``trackers`` adds the Vive trackers.
         vr_noise: ``"none"`` or ``"realistic"`` (scripts.stages.devices.REALISTIC_NOISE).
-        fisheye: projected 2D keypoints of the controller cameras (no images in this slice).
-        kinect: ``"none"``, ``"kinect-v2"`` or ``"azure-kinect"`` (skeleton only, no depth).
+        fisheye: projected 2D keypoints of the controller cameras.
+        fisheye_images: ``"none"``, ``"jpeg"`` or ``"png"``: the cameras' rendered images
+            (needs ``fisheye``).
+        kinect: ``"none"``, ``"kinect-v2"`` or ``"azure-kinect"``: the skeleton with
+            tracking states.
+        kinect_depth: the Kinect's 16-bit depth images in millimetres, PNG (needs a
+            ``kinect``).
+        image_stride: images and depth of every ``image_stride``-th camera frame (rendering
+            is most of a sample's time; 3 gives 10 Hz at the cameras' 30 Hz).
+        image_scale: fisheye image size factor (1: 640 x 480).
         physics: per-frame physics labels (contact, penetration, skate).
     """
 
@@ -80,7 +90,11 @@ class DeviceSetConfig:
     trackers: bool = False
     vr_noise: str = "none"
     fisheye: bool = True
+    fisheye_images: str = "none"
     kinect: str = "none"
+    kinect_depth: bool = False
+    image_stride: int = 3
+    image_scale: float = 0.5
     physics: bool = True
 
 
@@ -107,9 +121,25 @@ class DatasetConfig:
 
 
 def config_hash(config: DatasetConfig) -> str:
-    """sha256 (hex) of the normalised config, keys sorted."""
-    text = json.dumps(config.as_dict(), sort_keys=True, separators=(",", ":"))
+    """sha256 (hex) of the normalised config, keys sorted, each source's and device set's
+    keys at their defaults left out: a key added later whose default keeps the old output
+    (a new channel, off unless asked for) leaves the hash, and so resuming and verifying
+    datasets made before it, unchanged."""
+    data = config.as_dict()
+    for key, table in (("sources", config.sources), ("devices", config.devices)):
+        data[key] = [_without_defaults(t) for t in table]
+    text = json.dumps(data, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()
+
+
+def _without_defaults(table: Any) -> dict[str, Any]:
+    """The dataclass ``table`` as JSON data, fields equal to their defaults left out."""
+    values = json.loads(json.dumps(asdict(table)))
+    return {
+        f.name: values[f.name]
+        for f in fields(table)
+        if f.default is MISSING or getattr(table, f.name) != f.default
+    }
 
 
 def load_config(path: str | Path) -> DatasetConfig:
@@ -224,6 +254,17 @@ def _device(data: dict, index: int) -> DeviceSetConfig:
         raise ConfigError(f"{where}: vr_noise must be one of {', '.join(VR_NOISE)}")
     if device.kinect not in KINECT_SENSORS:
         raise ConfigError(f"{where}: kinect must be one of {', '.join(KINECT_SENSORS)}")
+    if device.fisheye_images not in IMAGE_FORMATS:
+        raise ConfigError(f"{where}: fisheye_images must be one of {', '.join(IMAGE_FORMATS)}")
+    if device.fisheye_images != "none" and not device.fisheye:
+        raise ConfigError(f"{where}: fisheye_images needs fisheye = true")
+    if device.kinect_depth and device.kinect == "none":
+        raise ConfigError(f"{where}: kinect_depth needs a kinect sensor")
+    if not isinstance(device.image_stride, int) or device.image_stride < 1:
+        raise ConfigError(f"{where}: image_stride must be an integer >= 1")
+    lo, hi = SCALE_RANGE
+    if not (isinstance(device.image_scale, int | float) and lo <= device.image_scale <= hi):
+        raise ConfigError(f"{where}: image_scale must be in [{lo:g}, {hi:g}]")
     if not device.name.replace("-", "").isalnum():
         raise ConfigError(f"{where}: name must be letters, digits and '-', got {device.name!r}")
     return device

@@ -1,31 +1,30 @@
-"""Generate a dataset with a local process pool; a shard is the unit of work.
+"""Generate a dataset; a shard is the unit of work.
 
-Each shard is made whole in memory, written to a temporary name and ``os.replace``d, then
+Each shard is made whole in memory by an executor (:mod:`.executors`: a local process pool
+or Ray), then written here, in this process, to a temporary name and ``os.replace``d, then
 its sidecar likewise (:mod:`.manifest`): a killed run leaves whole shards, at most some
 temporary files (removed by the next run) and no sidecar for a shard it did not finish.
 Resuming skips every shard whose tar's sha256 matches its sidecar and makes the rest; as
 a shard's bytes depend on its planned samples alone, the result is byte-identical to an
-uninterrupted run, whatever the worker count. The manifest is written last.
+uninterrupted run, whatever the worker count or executor. The manifest is written last.
 
-Workers are spawned (no state inherited from the parent), run BLAS single-threaded (the
-pool is the parallelism) and exit when the parent dies, so a ``kill -9`` of ``generate``
-leaves no orphan writing into the folder.
+A write that fails (a full disk, a folder made read-only) stops the run cleanly with a
+:class:`DatasetError`: the shards written so far stay and the next run resumes from them.
 """
 
 from __future__ import annotations
 
-import os
-import threading
+import hashlib
 import time
-from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from collections.abc import Callable, Iterator
+from contextlib import closing, contextmanager
 from dataclasses import dataclass
-from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
 from avatar_models.fileio import write_atomic, write_json
 from scripts.dataset.config import DatasetConfig, config_hash
+from scripts.dataset.executors import check_executor, run
 from scripts.dataset.manifest import (
     SHARD_DIR,
     STATE_FILE,
@@ -40,9 +39,7 @@ from scripts.dataset.manifest import (
 )
 from scripts.dataset.plan import ShardSpec, plan_samples, plan_shards
 from scripts.dataset.sample import make_sample
-from scripts.dataset.shards import sha256_file, shard_bytes
-
-PARENT_POLL_S = 0.5
+from scripts.dataset.shards import shard_bytes
 
 
 @dataclass(frozen=True)
@@ -59,27 +56,69 @@ class GenerateResult:
     manifest: dict[str, Any]
 
 
-def write_shard(root: Path, config: DatasetConfig, shard: ShardSpec) -> dict[str, Any]:
-    """Make shard ``shard`` of ``config`` in ``root`` and return its sidecar."""
+@dataclass(frozen=True)
+class MadeShard:
+    """A shard made in memory: its tar ``data`` and what its sidecar says of it."""
+
+    name: str
+    split: str
+    data: bytes
+    samples: int
+    frames: int
+    groups: list[str]
+
+
+def make_shard(config: DatasetConfig, shard: ShardSpec) -> MadeShard:
+    """Shard ``shard`` of ``config``, in memory (no file is touched: any executor runs it)."""
     chash = config_hash(config)
     entries = []
     for spec in shard.samples:
         arrays, meta = make_sample(config, spec, chash)
         entries.append((spec.key, arrays, meta))
-    tar = shard_path(root, shard.name)
-    write_atomic(tar, shard_bytes(entries))
+    return MadeShard(
+        name=shard.name,
+        split=shard.split,
+        data=shard_bytes(entries),
+        samples=len(entries),
+        frames=sum(meta["frames"] for _, _, meta in entries),
+        groups=sorted({meta["group"] for _, _, meta in entries}),
+    )
+
+
+def store_shard(root: Path, made: MadeShard) -> dict[str, Any]:
+    """Write ``made`` and then its sidecar into ``root`` (atomically); return the sidecar.
+
+    Raises:
+        DatasetError: the write failed (nothing of this shard is left half-written).
+    """
+    tar = shard_path(root, made.name)
     sidecar = {
-        "name": shard.name,
+        "name": made.name,
         "file": f"{SHARD_DIR}/{tar.name}",
-        "split": shard.split,
-        "sha256": sha256_file(tar),
-        "bytes": tar.stat().st_size,
-        "samples": len(entries),
-        "frames": sum(meta["frames"] for _, _, meta in entries),
-        "groups": sorted({meta["group"] for _, _, meta in entries}),
+        "split": made.split,
+        "sha256": hashlib.sha256(made.data).hexdigest(),
+        "bytes": len(made.data),
+        "samples": made.samples,
+        "frames": made.frames,
+        "groups": made.groups,
     }
-    write_sidecar(root, sidecar)
+    with resumable_writes(root, f"shard {made.name}"):
+        write_atomic(tar, made.data)
+        write_sidecar(root, sidecar)
     return sidecar
+
+
+@contextmanager
+def resumable_writes(root: Path, what: str) -> Iterator[None]:
+    """Turn a failed write of ``what`` (``OSError``: a full disk, lost permissions) into a
+    :class:`DatasetError` that says the run can be resumed."""
+    try:
+        yield
+    except OSError as exc:
+        raise DatasetError(
+            f"cannot write {what} in {root}: {exc.strerror or exc}; what was written so far "
+            "is kept: free space or fix permissions, then run generate again to resume"
+        ) from None
 
 
 def prepare(root: Path, config: DatasetConfig) -> None:
@@ -99,25 +138,12 @@ def prepare(root: Path, config: DatasetConfig) -> None:
                 f"--out {root} holds a dataset of another config or seed (config hash "
                 f"{str(previous.get('config_hash'))[:12]}); choose another folder"
             )
-    (root / SHARD_DIR).mkdir(parents=True, exist_ok=True)
-    for stale in (*root.glob(".*.tmp"), *(root / SHARD_DIR).glob(".*.tmp")):
-        stale.unlink(missing_ok=True)  # left by a killed run
-    if not (root / STATE_FILE).is_file():
-        write_json(root / STATE_FILE, state(config))
-
-
-def _watch_parent(parent: int) -> None:
-    """Pool initializer: one BLAS thread, and exit when the parent process is gone."""
-    from threadpoolctl import threadpool_limits
-
-    threadpool_limits(1)
-
-    def watch() -> None:
-        while os.getppid() == parent:
-            time.sleep(PARENT_POLL_S)
-        os._exit(1)
-
-    threading.Thread(target=watch, daemon=True).start()
+    with resumable_writes(root, "the dataset folder"):
+        (root / SHARD_DIR).mkdir(parents=True, exist_ok=True)
+        for stale in (*root.glob(".*.tmp"), *(root / SHARD_DIR).glob(".*.tmp")):
+            stale.unlink(missing_ok=True)  # left by a killed run
+        if not (root / STATE_FILE).is_file():
+            write_json(root / STATE_FILE, state(config))
 
 
 def generate(
@@ -126,15 +152,24 @@ def generate(
     workers: int = 1,
     on_start: Callable[[int, int], None] | None = None,
     on_shard: Callable[[int], None] | None = None,
+    executor: str = "local",
+    address: str | None = None,
 ) -> GenerateResult:
     """Generate (or resume) the dataset of ``config`` in ``root`` (module docstring).
 
     Args:
-        workers: processes; 1 makes the shards in this process.
+        workers: shards made at once (processes or Ray tasks); local 1 makes them here.
         on_start: called with (samples in all, samples already done) before any work.
         on_shard: called with the samples of each shard as it completes.
+        executor, address: ``"local"`` or ``"ray"``, and a Ray cluster to attach to
+            (:func:`scripts.dataset.executors.run`).
+
+    Raises:
+        DatasetError: ``root`` is foreign, or a write failed (resume later).
+        ExecutorError: the executor cannot run.
     """
     start = time.perf_counter()
+    check_executor(executor, workers, address)  # before anything is written
     shards = plan_shards(config, plan_samples(config))
     prepare(root, config)
     sidecars = {s.name: done_sidecar(root, s.name) for s in shards}
@@ -142,30 +177,16 @@ def generate(
     if on_start is not None:
         done = sum(len(s.samples) for s in shards if sidecars[s.name] is not None)
         on_start(sum(len(s.samples) for s in shards), done)
-    if workers <= 1:
-        for shard in todo:
-            sidecars[shard.name] = write_shard(root, config, shard)
+    items = [(config, shard) for shard in todo]
+    # closing: a failed write stops the executor now, not when the traceback is dropped
+    with closing(run(make_shard, items, executor, workers, address)) as made_shards:
+        for made in made_shards:
+            sidecars[made.name] = store_shard(root, made)
             if on_shard is not None:
-                on_shard(len(shard.samples))
-    else:
-        pool = ProcessPoolExecutor(
-            max_workers=workers,
-            mp_context=get_context("spawn"),
-            initializer=_watch_parent,
-            initargs=(os.getpid(),),
-        )
-        try:
-            futures = [pool.submit(write_shard, root, config, s) for s in todo]
-            for future in as_completed(futures):
-                sidecar = future.result()
-                sidecars[sidecar["name"]] = sidecar
-                if on_shard is not None:
-                    on_shard(sidecar["samples"])
-        finally:
-            # On an error or SIGTERM: finish the shards being written, start no others.
-            pool.shutdown(wait=True, cancel_futures=True)
+                on_shard(made.samples)
     manifest = build_manifest(config, [sidecars[s.name] for s in shards])
-    write_manifest(root, manifest)
+    with resumable_writes(root, "the manifest"):
+        write_manifest(root, manifest)
     return GenerateResult(
         shards=len(shards),
         samples=manifest["samples"],

@@ -8,8 +8,10 @@ JSON holds the split and group, the subject's parameters, the provenance (source
 window start, every seed, package version, config hash) and each channel's description.
 
 The devices' seed is split with ``SeedSequence`` into one stream per random channel, in a
-fixed order (VR, Kinect, fisheye detector), so that adding a channel later leaves the others'
-draws unchanged.
+fixed order (VR, Kinect, fisheye detector, fisheye images), so that adding a channel later
+leaves the others' draws unchanged. Images and depth are entries of their own
+(``<key>.fisheye_image.{camera}.{n:04d}.jpg``, ``<key>.kinect_depth.{n:04d}.png``): bytes in
+``arrays``, encoded files.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from avatar_models.rigs import body17_positions
 from scripts.dataset.channels import (
     f32,
     fisheye_channel,
+    fisheye_image_channel,
     kinect_channel,
     physics_channel,
     vr_channel,
@@ -45,7 +48,7 @@ def package_version() -> str:
 
 def channel_seeds(seed: int) -> dict[str, int]:
     """The random channels' seeds from the sample's devices seed (module docstring)."""
-    names = ("vr", "kinect", "fisheye")
+    names = ("vr", "kinect", "fisheye", "images")  # appended only: spawn(n)'s first children stay
     streams = np.random.SeedSequence(seed).spawn(len(names))
     return {name: int(s.generate_state(1)[0]) for name, s in zip(names, streams, strict=True)}
 
@@ -70,9 +73,15 @@ def make_sample(
     if devices.fisheye:
         arrays_fisheye, channels["fisheye"] = fisheye_channel(humanoid, seeds["fisheye"])
         arrays |= arrays_fisheye
+    if devices.fisheye_images != "none":
+        arrays_images, channels["fisheye_images"] = fisheye_image_channel(
+            humanoid, devices, seeds["images"]
+        )
+        arrays |= arrays_images
     if devices.kinect != "none":
+        depth_stride = devices.image_stride if devices.kinect_depth else 0
         arrays_kinect, channels["kinect"] = kinect_channel(
-            humanoid, devices.kinect, seeds["kinect"]
+            humanoid, devices.kinect, seeds["kinect"], depth_stride
         )
         arrays |= arrays_kinect
     if devices.physics:

@@ -1,7 +1,8 @@
 """WebDataset-layout tar shards, byte-deterministic.
 
 A shard is a plain POSIX (ustar) tar: each sample's entries ``<key>.<name>.npy`` (one per
-array, ``numpy.save`` format) then ``<key>.json``, samples in plan order, entries of a sample
+array, ``numpy.save`` format), ``<key>.<name>`` for an encoded image (bytes whose name ends
+``.jpg`` or ``.png``) then ``<key>.json``, samples in plan order, entries of a sample
 sorted by name. WebDataset groups consecutive entries by the key before the first dot, so
 ``webdataset.WebDataset(url)`` reads these shards as they are. Every header field that could
 vary between runs is fixed (mtime 0, uid/gid 0, no user or group name, mode 0644), and the
@@ -18,11 +19,13 @@ from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
+import cv2
 import numpy as np
 
 from avatar_models.fileio import json_safe
 
-SampleEntries = tuple[str, dict[str, np.ndarray], dict[str, Any]]
+SampleEntries = tuple[str, dict[str, np.ndarray | bytes], dict[str, Any]]
+IMAGE_EXTENSIONS = (".jpg", ".png")
 
 
 def _add(tar: tarfile.TarFile, name: str, data: bytes) -> None:
@@ -52,9 +55,21 @@ def shard_bytes(samples: list[SampleEntries]) -> bytes:
     with tarfile.open(fileobj=buffer, mode="w", format=tarfile.USTAR_FORMAT) as tar:
         for key, arrays, meta in samples:
             for name in sorted(arrays):
-                _add(tar, f"{key}.{name}.npy", npy_bytes(arrays[name]))
+                value = arrays[name]
+                if isinstance(value, bytes):
+                    _add(tar, f"{key}.{name}", value)
+                else:
+                    _add(tar, f"{key}.{name}.npy", npy_bytes(value))
             _add(tar, f"{key}.json", json_bytes(meta))
     return buffer.getvalue()
+
+
+def decode_image(data: bytes) -> np.ndarray:
+    """An encoded image entry as (H, W, 3) uint8 RGB or (H, W) uint16 (16-bit depth)."""
+    image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED)
+    if image is None:
+        raise ValueError("an image entry that does not decode")
+    return image[..., ::-1].copy() if image.ndim == 3 else image
 
 
 def sha256_file(path: Path) -> str:
@@ -66,7 +81,8 @@ def sha256_file(path: Path) -> str:
 
 
 def read_samples(path: Path) -> Iterator[tuple[str, dict[str, Any]]]:
-    """The samples of a shard in order: ``(key, {"json": dict, name: array...})``.
+    """The samples of a shard in order: ``(key, {"json": dict, name: array...})``; images
+    decoded, under their entry name with its extension (``fisheye_image.{camera}.0000.jpg``).
 
     Raises:
         tarfile.TarError: not a tar (a truncated or foreign file).
@@ -82,6 +98,8 @@ def read_samples(path: Path) -> Iterator[tuple[str, dict[str, Any]]]:
             data = tar.extractfile(member).read()
             if ext == "json":
                 sample["json"] = json.loads(data)
+            elif ext.endswith(IMAGE_EXTENSIONS):
+                sample[ext] = decode_image(data)
             else:
                 sample[ext.removesuffix(".npy")] = np.load(io.BytesIO(data), allow_pickle=False)
         if key is not None:

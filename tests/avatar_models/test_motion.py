@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation
+from scipy.spatial.transform import Rotation, Slerp
 
 from avatar_models import quat
 from avatar_models.errors import MotionValueError, UnknownJointError
-from avatar_models.motion import Motion
+from avatar_models.motion import Motion, forward_kinematics
 from avatar_models.rigs import load_rig
 from avatar_models.skeleton import Skeleton
 
@@ -90,6 +90,33 @@ def test_resample_keeps_duration_and_interpolates_by_slerp():
     np.testing.assert_allclose(
         b, 0.5 * np.array([np.cos(np.pi / 4), np.sin(np.pi / 4), 0]), atol=1e-12
     )
+
+
+def test_resample_matches_scipy_slerp_per_joint():
+    m = random_motion(np.random.default_rng(6), frames=12, fps=30.0)
+    times = np.random.default_rng(7).uniform(0, m.duration_s, 50)
+    expected = np.stack(
+        [
+            Slerp(m.times, quat.to_scipy(m.local_rot[:, j]))(times).as_matrix()
+            for j in range(m.skeleton.n_joints)
+        ],
+        axis=1,
+    )
+    np.testing.assert_allclose(quat.to_matrix(m.sample(times).local_rot), expected, atol=1e-12)
+
+
+def test_forward_kinematics_of_some_joints_equals_the_full_pass():
+    m = random_motion(np.random.default_rng(8), frames=5, fps=30.0)
+    pos, rot = m.fk()
+    leaf = m.skeleton.n_joints - 1
+    some_pos, some_rot = forward_kinematics(
+        m.skeleton, m.root_pos, quat.to_matrix(m.local_rot), [leaf]
+    )
+    chain = [leaf]
+    while m.skeleton.parents[chain[-1]] >= 0:
+        chain.append(int(m.skeleton.parents[chain[-1]]))
+    np.testing.assert_array_equal(some_pos[:, chain], pos[:, chain])
+    np.testing.assert_array_equal(some_rot[:, chain], rot[:, chain])
 
 
 def test_resample_round_trip_reproduces_original_frames():

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.spatial.transform import Rotation
+from scipy.spatial.transform import Rotation, Slerp
 
 from avatar_models import quat
 
@@ -18,6 +18,28 @@ def test_mul_rotate_conj_match_scipy():
     np.testing.assert_allclose(quat.rotate(qa, v), a.apply(v), atol=1e-12)
     np.testing.assert_allclose(quat.to_matrix(quat.conj(qa)), a.inv().as_matrix(), atol=1e-12)
     np.testing.assert_allclose(quat.angle(qa), a.magnitude(), atol=1e-12)
+
+
+def test_power_is_scipy_slerp_step():
+    rng = np.random.default_rng(4)
+    a, b = Rotation.random(40, random_state=rng), Rotation.random(40, random_state=rng)
+    t = rng.uniform(0, 1, 40)
+    expected = [Slerp([0, 1], Rotation.concatenate([a[k], b[k]]))(t[k]) for k in range(40)]
+    qa, qb = quat.from_scipy(a), quat.from_scipy(b)
+    # Either sign of the step quaternion means the same rotation: power takes the short arc.
+    step = quat.mul(quat.conj(qa), qb) * rng.choice([-1.0, 1.0], (40, 1))
+    got = quat.to_matrix(quat.mul(qa, quat.power(step, t)))
+    np.testing.assert_allclose(got, [r.as_matrix() for r in expected], atol=1e-12)
+    np.testing.assert_allclose(quat.power(step, 0.0), np.tile(quat.IDENTITY, (40, 1)), atol=0)
+    tiny = quat.from_axis_angle([0, 1, 0], np.array([0.0, 1e-300]))
+    np.testing.assert_array_equal(quat.power(tiny, 0.5), np.tile(quat.IDENTITY, (2, 1)))
+
+
+def test_from_matrix_of_orthonormal_matrices_skips_checks_with_same_result():
+    m = Rotation.random(30, random_state=5).as_matrix()
+    np.testing.assert_allclose(
+        np.abs(np.sum(quat.from_matrix(m, orthonormal=True) * quat.from_matrix(m), -1)), 1.0
+    )
 
 
 def test_axis_angle_yaw_and_continuity():

@@ -1,8 +1,16 @@
 from __future__ import annotations
 
+from dataclasses import field, fields, make_dataclass, replace
+
 import pytest
 
-from scripts.dataset.config import ConfigError, config_hash, from_dict, load_config
+from scripts.dataset.config import (
+    ConfigError,
+    DeviceSetConfig,
+    config_hash,
+    from_dict,
+    load_config,
+)
 from tests.scripts.dataset.builders import TINY, write_config
 
 
@@ -27,6 +35,11 @@ def test_tiny_config_loads_with_defaults(tmp_path):
         ({"splits": {"train": 0.9, "holdout": 0.1}}, "unknown split"),
         ({"devices": [{"name": "a", "kinect": "kinect-v3"}]}, "kinect must be"),
         ({"samples_per_shard": 0}, "samples_per_shard"),
+        ({"devices": [{"name": "a", "fisheye_images": "gif"}]}, "fisheye_images must be"),
+        ({"devices": [{"name": "a", "fisheye": False, "fisheye_images": "png"}]}, "needs fish"),
+        ({"devices": [{"name": "a", "kinect_depth": True}]}, "needs a kinect"),
+        ({"devices": [{"name": "a", "image_stride": 0}]}, "image_stride"),
+        ({"devices": [{"name": "a", "image_scale": 10.0}]}, "image_scale"),
     ],
 )
 def test_bad_configs_are_config_errors(tmp_path, changes, reason):
@@ -49,3 +62,20 @@ def test_relative_mocap_folders_are_relative_to_the_config(tmp_path):
     sources = [{"kind": "mocap", "path": "clips"}, {"kind": "mocap", "path": "/abs/clips"}]
     config = load_config(write_config(tmp_path / "c.toml", sources=sources))
     assert [s.path for s in config.sources] == [str(tmp_path / "clips"), "/abs/clips"]
+
+
+def test_a_key_added_later_at_its_default_leaves_the_hash():
+    """A device-set key that a later version adds (a new channel, off by default) must not
+    change the identity of datasets made before it: they still resume and verify."""
+    later = make_dataclass(
+        "LaterDeviceSet",
+        [("new_channel", bool, field(default=False))],
+        bases=(DeviceSetConfig,),
+        frozen=True,
+    )
+    config = from_dict(TINY)
+    device = config.devices[0]
+    with_new = later(**{f.name: getattr(device, f.name) for f in fields(device)})
+    assert config_hash(replace(config, devices=(with_new,))) == config_hash(config)
+    switched_on = replace(with_new, new_channel=True)
+    assert config_hash(replace(config, devices=(switched_on,))) != config_hash(config)

@@ -1,12 +1,15 @@
 from __future__ import annotations
 
+import errno
 import json
+import os
 import shutil
 
 import pytest
 from typer.testing import CliRunner
 
 from scripts.cli import app
+from scripts.dataset import runner as runner_module
 from tests.scripts.dataset.builders import tree_bytes, write_config
 
 runner = CliRunner()
@@ -68,9 +71,28 @@ def test_unwritable_out_exits_2(tiny_config_path, tmp_path):
     assert "error:" in result.output
 
 
-def test_out_that_is_a_file_and_ray_exit_2(tiny_config_path, tmp_path):
+def test_out_that_is_a_file_and_bad_executors_exit_2(tiny_config_path, tmp_path):
     a_file = tmp_path / "file"
     a_file.write_text("x")
-    for extra in (["--out", str(a_file)], ["--out", str(tmp_path / "d"), "--executor", "ray"]):
+    out = ["--out", str(tmp_path / "d")]
+    for extra in (
+        ["--out", str(a_file)],
+        [*out, "--executor", "dask"],
+        [*out, "--address", "auto"],  # a Ray address without --executor ray
+        [*out, "--workers", "0"],
+    ):
         result = runner.invoke(app, ["dataset", "generate", str(tiny_config_path), *extra])
         assert result.exit_code == 2, result.output
+    assert not (tmp_path / "d").exists()
+
+
+def test_a_full_disk_exits_2_and_says_how_to_resume(tiny_config_path, tmp_path, monkeypatch):
+    def no_space(path, data):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
+
+    monkeypatch.setattr(runner_module, "write_atomic", no_space)
+    out = tmp_path / "ds"
+    result = runner.invoke(app, ["dataset", "generate", str(tiny_config_path), "--out", str(out)])
+    assert result.exit_code == 2, result.output
+    assert "No space left" in result.output and "resume" in result.output
+    assert not list((out / "shards").iterdir()) and not (out / "manifest.json").exists()

@@ -1,5 +1,7 @@
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -7,6 +9,7 @@ from avatar_models.body17 import INDEX
 from scripts.dataset.config import config_hash, from_dict
 from scripts.dataset.plan import plan_samples
 from scripts.dataset.sample import make_sample
+from scripts.dataset.shards import read_samples, shard_bytes
 from tests.scripts.dataset.builders import TINY
 
 
@@ -79,3 +82,56 @@ def test_real_clip_sample(mocap_dir):
     assert meta["activity"] == "running"
     assert arrays["body17"].shape == (31, 17, 3)
     assert 1.3 < np.median(arrays["body17"][:, INDEX["head"], 2]) < 2.1
+
+
+@pytest.fixture(scope="module")
+def imaged_sample():
+    """A short window (7 frames at 30 Hz) with fisheye JPEGs and Kinect depth every third
+    frame, at a quarter of the image size."""
+    devices = {
+        "name": "img",
+        "fisheye_images": "jpeg",
+        "kinect": "kinect-v2",
+        "kinect_depth": True,
+        "image_scale": 0.25,
+    }
+    config = from_dict({**TINY, "window": {"seconds": 0.2, "fps": 30.0}, "devices": [devices]})
+    spec = plan_samples(config)[0]
+    return config, spec, *make_sample(config, spec, config_hash(config))
+
+
+def test_images_and_depth_are_encoded_entries_at_the_stride(imaged_sample, tmp_path):
+    config, spec, arrays, meta = imaged_sample
+    frames = [0, 3, 6]  # every 3rd of the 7 camera (and Kinect) frames at 30 Hz
+    assert arrays["fisheye_image_frames"].tolist() == frames
+    assert arrays["kinect_depth_frames"].tolist() == frames
+    cameras = meta["channels"]["fisheye_images"]["cameras"]
+    jpegs = sorted(n for n in arrays if n.startswith("fisheye_image.") and n.endswith(".jpg"))
+    assert len(cameras) == 4 and len(jpegs) == 4 * len(frames)
+    assert all(arrays[n][:2] == b"\xff\xd8" for n in jpegs)  # JPEG start-of-image marker
+    pngs = sorted(n for n in arrays if n.startswith("kinect_depth."))
+    assert len(pngs) == len(frames) and arrays[pngs[0]][:8] == b"\x89PNG\r\n\x1a\n"
+    # Decoded from a shard: RGB at a quarter of 640 x 480, depth 16-bit at the Kinect v2's
+    # 512 x 424, with the performer's pixels about where the sensor record puts them.
+    path = tmp_path / "s.tar"
+    path.write_bytes(shard_bytes([(spec.key, arrays, meta)]))
+    _, sample = next(read_samples(path))
+    assert sample[jpegs[0]].shape == (120, 160, 3) and sample[jpegs[0]].dtype == np.uint8
+    depth = sample[pngs[0]]
+    assert depth.shape == (424, 512) and depth.dtype == np.uint16
+    performer_mm = 1000 * meta["channels"]["kinect"]["performer_depth_m_median"]
+    assert np.any(np.abs(depth.astype(float) - performer_mm) < 300)
+
+
+def test_images_are_deterministic_and_leave_the_other_channels_unchanged(imaged_sample):
+    config, spec, arrays, _ = imaged_sample
+    again, _ = make_sample(config, spec, config_hash(config))
+    assert all(_same(arrays[n], again[n]) for n in arrays)
+    plain = replace(config.devices[0], fisheye_images="none", kinect_depth=False)
+    without, _ = make_sample(replace(config, devices=(plain,)), spec, config_hash(config))
+    assert set(without) < set(arrays)
+    assert all(_same(without[n], arrays[n]) for n in without)
+
+
+def _same(a, b) -> bool:
+    return a == b if isinstance(a, bytes) else np.array_equal(a, b)
