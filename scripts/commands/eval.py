@@ -122,11 +122,29 @@ def register(app: typer.Typer) -> None:
             int, typer.Option(help="Database copies turned to this many yaws (beyond the paper).")
         ] = 1,
         quick: Annotated[bool, typer.Option(help="Small inputs, for a smoke run.")] = False,
+        model: Annotated[
+            Path | None, typer.Option(help="controllerpose: the run folder of the model.")
+        ] = None,
+        data: Annotated[
+            Path | None, typer.Option(help="controllerpose: the dataset folder (test split).")
+        ] = None,
+        no_vr_model: Annotated[
+            Path | None, typer.Option(help="controllerpose: a --no-vr run, for the ablation.")
+        ] = None,
+        frame_stride: Annotated[
+            int, typer.Option(help="controllerpose: every k-th camera frame.")
+        ] = 3,
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
     ) -> None:
         """Accuracy protocols of a synthesis method, IK baseline beside (CoolMoves §4.1), or
-        ``leaderboard``: every registered method (scripts/leaderboard.py)."""
+        ``leaderboard``: every registered method (scripts/leaderboard.py), or
+        ``controllerpose --model RUN --data DIR`` (scripts/controllerpose/evaluation.py)."""
+        if method == "controllerpose":
+            from scripts.controllerpose.evaluation import evaluate_command
+
+            evaluate_command(model, data, no_vr_model, frame_stride, out, json_out)
+            return
         from scripts.leaderboard import run_leaderboard
         from synthesis.evaluate import (
             EVALUABLE,
