@@ -13,6 +13,7 @@ from render_cams.tracking import TrackingStream
 from scripts.results import ThresholdResult
 from scripts.scenario import Scenario
 from sim.humanoid import Humanoid
+from synthesis.controllerpose.synthesizer import KeypointRecording
 
 
 @dataclass
@@ -24,6 +25,8 @@ class RunContext:
         humanoid: its body, built once (stage ``body``) and used by every later stage.
         vr_stream: the simulated VR tracking stream (stage ``devices``; None without
             ``[devices] vr``), the synthesisers' input.
+        fisheye_keypoints: the controller cameras' keypoints (stage ``devices``; None
+            without ``[devices] fisheye``), ControllerPose's input.
         synthesised: each method's output on the humanoid, by method name (stage
             ``synthesis``; empty without ``[synthesis]``).
         metrics: thresholded by ``[thresholds]``.
@@ -38,6 +41,7 @@ class RunContext:
     motion: Motion | None = None
     humanoid: Humanoid | None = None
     vr_stream: TrackingStream | None = None
+    fisheye_keypoints: KeypointRecording | None = None
     synthesised: dict[str, Humanoid] = field(default_factory=dict)
     metrics: dict[str, float] = field(default_factory=dict)
     checks: list[ThresholdResult] = field(default_factory=list)

@@ -95,9 +95,11 @@ class DevicesSpec:
     """Simulated VR tracking (``render_cams.vr``); ``noise`` is ``"none"`` or ``"realistic"``
     (Lighthouse-grade jitter, latency, slow drift). For sweeps, ``latency_s``, ``jitter_m``
     (position, per axis) and ``dropouts_per_s`` (0.5 s bursts of tracking loss) add one
-    more model each, after the preset."""
+    more model each, after the preset. ``fisheye`` records the controller cameras' 2D
+    keypoints too (ControllerPose's input)."""
 
     vr: bool = True
+    fisheye: bool = False
     trackers: bool = False
     noise: str = "realistic"
     latency_s: float = 0.0

@@ -19,6 +19,11 @@ from functools import cached_property
 from avatar_models import Skeleton
 from render_cams.vr import Attachment
 from synthesis.base import SynthesisError, Synthesizer
+from synthesis.controllerpose.synthesizer import (
+    ControllerPose,
+    KeypointRecording,
+    default_checkpoint,
+)
 from synthesis.coolmoves import CoolMoves, Database, Options
 from synthesis.ik_baseline import IKBaseline
 
@@ -39,6 +44,8 @@ class MethodInputs:
             position only (the rigs' hand frames differ).
         coolmoves: option overrides for every CoolMoves variant (e.g. a scenario's
             ``foot_contact``), applied on top of the variant's own.
+        fisheye: the controller cameras' keypoints (ControllerPose), or None when the
+            scenario records none (``[devices] fisheye = true``).
     """
 
     database_factory: Callable[[], Database]
@@ -46,6 +53,7 @@ class MethodInputs:
     rig: Skeleton
     calibration: Sequence[Attachment] | None = None
     coolmoves: dict = field(default_factory=dict)
+    fisheye: KeypointRecording | None = None
 
     @cached_property
     def database(self) -> Database:
@@ -77,6 +85,17 @@ def coolmoves(name: str, summary: str, options: Options) -> Method:
     return Method(name, summary, build, options)
 
 
+def controllerpose(inputs: MethodInputs) -> Synthesizer:
+    """ControllerPose (§4.3) with the trained model of :func:`default_checkpoint` on the
+    scored rig, from the controller cameras' keypoints and the VR stream."""
+    if inputs.fisheye is None:
+        raise SynthesisError(
+            "controllerpose needs the controller cameras' keypoints: enable [devices] "
+            "fisheye = true in the scenario"
+        )
+    return ControllerPose(default_checkpoint(), inputs.fisheye, inputs.rig, inputs.user_height_m)
+
+
 def ik_baseline(inputs: MethodInputs) -> Synthesizer:
     """The VRIK-like baseline on the scored rig (:class:`~synthesis.ik_baseline.IKBaseline`)."""
     own = inputs.calibration is None
@@ -101,6 +120,11 @@ METHODS: dict[str, Method] = {
             Options(align_about_centroid=True),
         ),
         Method("ik", "VRIK-like full-body IK from headset and controllers (§4.1.1)", ik_baseline),
+        Method(
+            "controllerpose",
+            "ControllerPose: controller-camera keypoints + VR lifted by a network, IK (§4.3)",
+            controllerpose,
+        ),
     )
 }
 """Every registered method by name (AvatarGo, MoveBox and ControllerPose join as they land)."""

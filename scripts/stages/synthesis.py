@@ -79,6 +79,7 @@ def method_inputs(ctx: RunContext, user_height_m: float) -> MethodInputs:
         rig=ctx.humanoid.body.skeleton,
         calibration=ik_calibration(ctx),
         coolmoves={"foot_contact": ctx.scenario.synthesis.foot_contact},
+        fisheye=ctx.fisheye_keypoints,
     )
 
 
