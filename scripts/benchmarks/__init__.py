@@ -20,6 +20,7 @@ BENCHMARKS: dict[str, str] = {
     "kinect": "kinect",
     "control": "control",
     "suite": "suite",
+    "controllerpose": "controllerpose",
 }
 
 
