@@ -3,9 +3,10 @@
 Reads the split through :class:`scripts.dataset.torch_dataset.ShardDataset` (in shard
 order) and turns each sample into :class:`~synthesis.controllerpose.examples.Examples`: the
 controller cameras' keypoints (``fisheye_uv``, ``fisheye_conf``) at their frame times, the
-VR stream (``vr_*``), and the ground truth ``body17`` at the camera frames. Uses the
-sample's ``body17_angles`` label channel when present only as a check that it matches
-(the targets are recomputed in the head's heading frame).
+VR stream (``vr_*``), and the ground truth ``body17`` at the camera frames. The angle
+targets are computed from ``body17`` in the head's heading frame (the ``body17_angles``
+label channel is the same parameterisation in the world frame; datasets generated before
+it existed lack it).
 """
 
 from __future__ import annotations
