@@ -10,22 +10,18 @@ ablation without VR features and its increase over the full model (paper: +25.5%
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 from typing import Any
 
-import matplotlib
+import numpy as np
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from avatar_models.body17 import BODY17  # noqa: E402
-from avatar_models.errors import AvatarsimError  # noqa: E402
-from avatar_models.fileio import write_atomic, write_json  # noqa: E402
-from scripts.controllerpose.data import load_examples  # noqa: E402
-from synthesis.controllerpose.checkpoint import load  # noqa: E402
-from synthesis.controllerpose.evaluate import (  # noqa: E402
+from avatar_models.body17 import BODY17
+from avatar_models.errors import AvatarsimError
+from avatar_models.fileio import write_json
+from scripts.controllerpose.data import load_examples
+from scripts.controllerpose.figures import plt, save_png
+from synthesis.controllerpose.checkpoint import load
+from synthesis.controllerpose.evaluate import (
     joint_errors,
     model_positions,
     nearest_neighbour_positions,
@@ -53,11 +49,7 @@ def plot_per_joint(results: dict[str, dict], path: Path) -> None:
     ax.set_xticks(x + 0.4 - width / 2, BODY17, rotation=45, ha="right")
     ax.set_ylabel("mean 3D error (cm), §5.3 normalised")
     ax.legend()
-    fig.tight_layout()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=100)
-    plt.close(fig)
-    write_atomic(path, buffer.getvalue())
+    save_png(fig, path)
 
 
 def run_evaluation(

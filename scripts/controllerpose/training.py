@@ -8,22 +8,17 @@ config resumes it; one of another dataset or config is refused (choose another `
 
 from __future__ import annotations
 
-import io
 import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
-from avatar_models.fileio import write_atomic, write_json  # noqa: E402
-from scripts.controllerpose.data import load_examples, manifest_sha256  # noqa: E402
-from synthesis.controllerpose.checkpoint import FILE, CheckpointError, load  # noqa: E402
-from synthesis.controllerpose.network import NetConfig  # noqa: E402
-from synthesis.controllerpose.train import TrainConfig, train  # noqa: E402
+from avatar_models.fileio import write_json
+from scripts.controllerpose.data import load_examples, manifest_sha256
+from scripts.controllerpose.figures import plt, save_png
+from synthesis.controllerpose.checkpoint import FILE, CheckpointError, load
+from synthesis.controllerpose.network import NetConfig
+from synthesis.controllerpose.train import TrainConfig, train
 
 
 def resumable(out: Path, net: NetConfig, config: TrainConfig, sha: str):
@@ -55,11 +50,7 @@ def plot_losses(history: list[dict[str, float]], path: Path) -> None:
                 ax.plot(epochs, values, label=split)
         ax.set(xlabel="epoch", ylabel=f"{key} ({unit})", yscale="log")
         ax.legend()
-    fig.tight_layout()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=100)
-    plt.close(fig)
-    write_atomic(path, buffer.getvalue())
+    save_png(fig, path)
 
 
 def run_training(
