@@ -134,6 +134,9 @@ def register(app: typer.Typer) -> None:
         frame_stride: Annotated[
             int, typer.Option(help="controllerpose: every k-th camera frame.")
         ] = 3,
+        mocap: Annotated[
+            Path | None, typer.Option(help="controllerpose: also held-out real clips here.")
+        ] = None,
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
     ) -> None:
@@ -143,7 +146,7 @@ def register(app: typer.Typer) -> None:
         if method == "controllerpose":
             from scripts.controllerpose.evaluation import evaluate_command
 
-            evaluate_command(model, data, no_vr_model, frame_stride, out, json_out)
+            evaluate_command(model, data, no_vr_model, frame_stride, out, json_out, mocap)
             return
         from scripts.leaderboard import run_leaderboard
         from synthesis.evaluate import (

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from avatar_models.rigs import body17_positions
 from scripts.dataset.manifest import MANIFEST_FILE, DatasetError, read_manifest
 from scripts.dataset.torch_dataset import ShardDataset
 from synthesis.controllerpose.examples import Examples, VRStream, concat, recording_examples
@@ -88,4 +89,50 @@ def load_examples(root: str | Path, split: str, frame_stride: int = 1) -> Exampl
         )
     if not parts:
         raise DatasetError(f"{root}: the {split} split has no samples")
+    return concat(parts)
+
+
+def mocap_examples(folder: Path, clips: int, seconds: float, seed: int = 0) -> Examples:
+    """Held-out real mocap as examples: ``clips`` BVH files spread evenly over ``folder``'s
+    (sorted) tree, their first ``seconds`` each, on the humanoid (a foreign rig retargeted)
+    and rendered through the simulated devices as the datasets are (projected keypoints,
+    VR with realistic noise).
+
+    Raises:
+        DatasetError: the folder has no BVH file.
+    """
+    from avatar_models.formats.bvh import read_bvh
+    from avatar_models.measure import standing_height
+    from render_cams.vr import HEADSET_AND_CONTROLLERS, VRSetup
+    from scripts.controllerpose.recording import keypoint_recording
+    from scripts.stages.devices import REALISTIC_NOISE
+    from sim.humanoid import humanoid_for
+
+    files = sorted(Path(folder).rglob("*.bvh"))
+    if not files:
+        raise DatasetError(f"{folder}: no .bvh clip to evaluate on")
+    picked = [files[i] for i in np.linspace(0, len(files) - 1, min(clips, len(files))).astype(int)]
+    setup = VRSetup(devices=HEADSET_AND_CONTROLLERS, noise=REALISTIC_NOISE)
+    parts = []
+    for group, path in enumerate(picked):
+        motion = read_bvh(path)
+        humanoid = humanoid_for(motion[: int(seconds * motion.fps)])
+        recording = keypoint_recording(humanoid)
+        truth = humanoid.motion.sample(recording.time)
+        stream = setup.sample(humanoid.motion, seed=seed + group)
+        vr = VRStream(
+            stream.timestamps, stream.positions, stream.quaternions, stream.valid,
+            stream.device_names,
+        )  # fmt: skip
+        parts.append(
+            recording_examples(
+                body17_positions(truth),
+                recording.uv,
+                recording.conf,
+                recording.time,
+                vr,
+                standing_height(humanoid.motion),
+                group,
+            )  # fmt: skip
+        )
     return concat(parts)

@@ -4,8 +4,10 @@ On the held-out split (``test``: subjects that never reached train), in §5.3's 
 frame (:func:`synthesis.controllerpose.evaluate.normalise`): the model's mean joint error
 overall and without hip and torso, each with its SD, per joint (a Fig. 9-like chart,
 ``per_joint.png``), the nearest-neighbour baseline on the same features (database: the
-train split), and, given ``--ablation RUN`` (a model trained with ``--no-vr``), the §5.3
-ablation without VR features and its increase over the full model (paper: +25.5%).
+train split), and, given ``--no-vr-model RUN`` (a model trained with ``--no-vr``), the
+§5.3 ablation without VR features and its increase over the full model (paper: +25.5%).
+Given ``--mocap FOLDER``, the same on held-out real clips (Bandai, CMU) rendered through
+the simulated devices (:func:`scripts.controllerpose.data.mocap_examples`).
 """
 
 from __future__ import annotations
@@ -18,9 +20,9 @@ import numpy as np
 from avatar_models.body17 import BODY17
 from avatar_models.errors import AvatarsimError
 from avatar_models.fileio import write_json
-from scripts.controllerpose.data import load_examples
+from scripts.controllerpose.data import load_examples, mocap_examples
 from scripts.controllerpose.figures import plt, save_png
-from synthesis.controllerpose.checkpoint import load
+from synthesis.controllerpose.checkpoint import Checkpoint, load
 from synthesis.controllerpose.evaluate import (
     joint_errors,
     model_positions,
@@ -28,12 +30,14 @@ from synthesis.controllerpose.evaluate import (
     normalise,
     summary,
 )
+from synthesis.controllerpose.examples import Examples
 
 
 class EvaluationError(AvatarsimError, ValueError):
     """Options of ``eval controllerpose`` that cannot work."""
 
 
+MOCAP_SECONDS = 4.0
 PAPER = {"mean_cm": 6.98, "sd_cm": 4.2, "limbs_mean_cm": 8.59, "no_vr_mean_cm": 8.76}
 
 
@@ -52,15 +56,13 @@ def plot_per_joint(results: dict[str, dict], path: Path) -> None:
     save_png(fig, path)
 
 
-def run_evaluation(
-    model: Path, data: Path, out: Path, ablation: Path | None, frame_stride: int
-) -> dict[str, Any]:
-    """Evaluates (module docstring), writes ``out/eval.json`` and ``out/per_joint.png``."""
-    checkpoint = load(model)
-    ablation_checkpoint = load(ablation) if ablation is not None else None
-    test = load_examples(data, "test", frame_stride)
-    test.features.check_finite(f"{data} test split")
-    train = load_examples(data, "train", frame_stride)
+def split_results(
+    checkpoint: Checkpoint,
+    ablation: Checkpoint | None,
+    test: Examples,
+    train: Examples,
+) -> dict[str, dict]:
+    """The model, the nearest-neighbour baseline and the ablation on ``test``."""
     truth = normalise(test.positions.astype(np.float64), test.height)
     results = {
         "controllerpose": summary(
@@ -70,9 +72,38 @@ def run_evaluation(
             joint_errors(nearest_neighbour_positions(checkpoint, train, test), truth)
         ),
     }
-    if ablation_checkpoint is not None:
+    if ablation is not None:
         results["controllerpose-no-vr"] = summary(
-            joint_errors(normalise(model_positions(ablation_checkpoint, test), test.height), truth)
+            joint_errors(normalise(model_positions(ablation, test), test.height), truth)
+        )
+    return results
+
+
+def run_evaluation(
+    model: Path,
+    data: Path,
+    out: Path,
+    ablation: Path | None,
+    frame_stride: int,
+    mocap: Path | None = None,
+    mocap_clips: int = 6,
+) -> dict[str, Any]:
+    """Evaluates (module docstring), writes ``out/eval.json`` and ``out/per_joint.png``."""
+    checkpoint = load(model)
+    ablation_checkpoint = load(ablation) if ablation is not None else None
+    test = load_examples(data, "test", frame_stride)
+    test.features.check_finite(f"{data} test split")
+    train = load_examples(data, "train", frame_stride)
+    results = split_results(checkpoint, ablation_checkpoint, test, train)
+    real = None
+    if mocap is not None:
+        clips = mocap_examples(mocap, mocap_clips, MOCAP_SECONDS)
+        clips.features.check_finite(f"{mocap} clips")
+        real = split_results(
+            checkpoint,
+            ablation_checkpoint,
+            clips.take(np.arange(0, len(clips), frame_stride)),
+            train,
         )
     full = results["controllerpose"]["mean_cm"]
     report = {
@@ -86,6 +117,8 @@ def run_evaluation(
             if ablation_checkpoint is not None
             else None
         ),
+        "real_mocap": real,
+        "real_mocap_folder": None if mocap is None else str(mocap),
         "paper": PAPER,
     }
     out.mkdir(parents=True, exist_ok=True)
@@ -101,6 +134,7 @@ def evaluate_command(
     frame_stride: int,
     out: Path,
     json_out: Path | None,
+    mocap: Path | None = None,
 ) -> None:
     """``avatarsim eval controllerpose``: checks the options, evaluates, prints a table."""
     from rich.table import Table
@@ -112,17 +146,19 @@ def evaluate_command(
     if frame_stride < 1:
         raise EvaluationError(f"--frame-stride must be at least 1, got {frame_stride}")
     check_outputs(json_out=json_out, out=out)
-    report = run_evaluation(model, data, out, no_vr_model, frame_stride)
-    table = Table(title=f"ControllerPose on {data} ({report['split']}), §5.3 normalised")
-    for column in ("method", "mean cm (SD)", "without hip+torso cm (SD)", "frames"):
+    report = run_evaluation(model, data, out, no_vr_model, frame_stride, mocap)
+    table = Table(title=f"ControllerPose, §5.3 normalised, test: {report['split']}")
+    for column in ("test", "method", "mean cm (SD)", "without hip+torso cm (SD)", "frames"):
         table.add_column(column)
-    for name, res in report["results"].items():
-        table.add_row(
-            name,
-            f"{res['mean_cm']:.2f} ({res['sd_cm']:.2f})",
-            f"{res['limbs_mean_cm']:.2f} ({res['limbs_sd_cm']:.2f})",
-            str(res["frames"]),
-        )
+    for split, results in (("dataset", report["results"]), ("real mocap", report["real_mocap"])):
+        for name, res in (results or {}).items():
+            table.add_row(
+                split,
+                name,
+                f"{res['mean_cm']:.2f} ({res['sd_cm']:.2f})",
+                f"{res['limbs_mean_cm']:.2f} ({res['limbs_sd_cm']:.2f})",
+                str(res["frames"]),
+            )
     console.print(table)
     if report["no_vr_increase_pct"] is not None:
         console.print(f"without VR: {report['no_vr_increase_pct']:+.1f}% (paper: +25.5%)")
