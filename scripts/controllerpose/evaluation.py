@@ -86,7 +86,7 @@ def run_evaluation(
     ablation: Path | None,
     frame_stride: int,
     mocap: Path | None = None,
-    mocap_clips: int = 6,
+    mocap_clips: int = 4,
 ) -> dict[str, Any]:
     """Evaluates (module docstring), writes ``out/eval.json`` and ``out/per_joint.png``."""
     checkpoint = load(model)
