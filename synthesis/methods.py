@@ -23,6 +23,7 @@ from synthesis.controllerpose.synthesizer import (
     ControllerPose,
     KeypointRecording,
     default_checkpoint,
+    model_missing,
 )
 from synthesis.coolmoves import CoolMoves, Database, Options
 from synthesis.ik_baseline import IKBaseline
@@ -64,12 +65,19 @@ class MethodInputs:
 class Method:
     """A registered method: its ``name``, a one-line ``summary`` and its ``build``er; the
     CoolMoves variants also carry their :class:`~synthesis.coolmoves.Options` (the
-    ablation switches them one at a time)."""
+    ablation switches them one at a time). ``missing`` says what a method still needs
+    before it can be built (a trained model), or None when it is ready."""
 
     name: str
     summary: str
     build: Callable[[MethodInputs], Synthesizer]
     options: Options | None = None
+    missing: Callable[[], str | None] = lambda: None
+
+
+def ready_methods() -> list[str]:
+    """The registered methods that can be built now (the default set to compare)."""
+    return [name for name, m in METHODS.items() if m.missing() is None]
 
 
 def coolmoves(name: str, summary: str, options: Options) -> Method:
@@ -124,6 +132,7 @@ METHODS: dict[str, Method] = {
             "controllerpose",
             "ControllerPose: controller-camera keypoints + VR lifted by a network, IK (§4.3)",
             controllerpose,
+            missing=model_missing,
         ),
     )
 }

@@ -35,7 +35,7 @@ from avatar_models.measure import standing_height
 from render_cams import TrackingStream
 from render_cams.vr import HEADSET_AND_CONTROLLERS, nominal_attachment
 from synthesis.base import DEFAULT_RATE_HZ, FrameBatch, Poses, SynthesisError, Synthesizer
-from synthesis.controllerpose.checkpoint import Checkpoint, load
+from synthesis.controllerpose.checkpoint import FILE, Checkpoint, load
 from synthesis.controllerpose.examples import VRStream, frame_features
 from synthesis.controllerpose.features import SKELETON_SLOTS, heading_matrix, latest_sample
 from synthesis.controllerpose.fk import forward_kinematics
@@ -74,10 +74,25 @@ class KeypointRecording:
             raise SynthesisError("keypoint times must be finite and increasing")
 
 
+def default_model() -> Path:
+    """``$AVATARSIM_CONTROLLERPOSE_MODEL`` (a run folder), else ``out/controllerpose``."""
+    return Path(os.environ.get(MODEL_ENV, DEFAULT_MODEL))
+
+
 def default_checkpoint() -> Checkpoint:
-    """The model at ``$AVATARSIM_CONTROLLERPOSE_MODEL`` (a run folder), else
-    ``out/controllerpose`` (raises :class:`~.checkpoint.CheckpointError` when absent)."""
-    return load(os.environ.get(MODEL_ENV, DEFAULT_MODEL))
+    """The model of :func:`default_model` (raises :class:`~.checkpoint.CheckpointError`
+    when absent)."""
+    return load(default_model())
+
+
+def model_missing() -> str | None:
+    """Why the method cannot run yet (no trained model), or None."""
+    if (default_model() / FILE).is_file():
+        return None
+    return (
+        f"no trained model in {default_model()} (avatarsim train controllerpose --out "
+        f"{DEFAULT_MODEL}, or set {MODEL_ENV})"
+    )
 
 
 class ControllerPose(Synthesizer):
