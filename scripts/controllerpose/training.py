@@ -3,7 +3,8 @@
 ``RUN/checkpoint.pt`` (:mod:`synthesis.controllerpose.checkpoint`, saved after every epoch),
 ``RUN/loss.png`` (train and validation curves) and ``RUN/train.json`` (config, history,
 timing). A run folder that holds a checkpoint of the same dataset (manifest sha256) and
-config resumes it; one of another dataset or config is refused (choose another ``--out``).
+config resumes it, with the new stopping rule (``--max-epochs``, ``--time-budget``,
+``--patience`` may grow); one of another dataset or config is refused (another ``--out``).
 """
 
 from __future__ import annotations
@@ -20,6 +21,14 @@ from synthesis.controllerpose.checkpoint import FILE, CheckpointError, load
 from synthesis.controllerpose.network import NetConfig
 from synthesis.controllerpose.train import TrainConfig, train
 
+# What may change between a run and its resumption: how long it goes on.
+STOPPING = ("max_epochs", "time_budget_s", "patience")
+
+
+def same_run(train_config: dict) -> dict:
+    """The training config without :data:`STOPPING` (a run's identity)."""
+    return {k: v for k, v in train_config.items() if k not in STOPPING}
+
 
 def resumable(out: Path, net: NetConfig, config: TrainConfig, sha: str):
     """The checkpoint in ``out`` to resume, or None for a fresh run.
@@ -30,7 +39,7 @@ def resumable(out: Path, net: NetConfig, config: TrainConfig, sha: str):
     if not (out / FILE).is_file():
         return None
     previous = load(out)
-    if previous.manifest_sha256 != sha or previous.train != config.as_dict():
+    if previous.manifest_sha256 != sha or same_run(previous.train) != same_run(config.as_dict()):
         raise CheckpointError(
             f"{out} holds a run of another dataset or training config; choose another --out"
         )

@@ -146,6 +146,7 @@ def train(
         optimiser.load_state_dict(resume.resume["optimiser"])
         schedule.load_state_dict(resume.resume["schedule"])
         checkpoint = resume
+        checkpoint.train = config.as_dict()
     n = len(train_set)
     start = time.perf_counter() - checkpoint.resume["elapsed_s"]
     while checkpoint.epoch < config.max_epochs:
