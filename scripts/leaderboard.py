@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from avatar_models import Motion
 from avatar_models.measure import standing_height
 from render_cams import VRSetup
 from render_cams.vr import FULL_BODY
@@ -30,6 +31,7 @@ from scripts.report_html import image_html, page, table_html
 from sim.thresholds import CheckConfig
 from synthesis.avatargo.study import walk_in
 from synthesis.base import SynthesisError
+from synthesis.controllerpose.synthesizer import KeypointRecording
 from synthesis.evaluate import (
     EvaluationError,
     Trial,
@@ -38,7 +40,7 @@ from synthesis.evaluate import (
     ik_rig_for,
 )
 from synthesis.evaluate.validation import choose_max_distance
-from synthesis.methods import METHODS, MethodInputs, build
+from synthesis.methods import METHODS, MethodInputs, build, ready_methods
 
 COLUMNS = {
     "hands_cm": "hands",
@@ -61,6 +63,14 @@ PHYSICS = (
     "residual_force_bw_p95",
 )
 """The physics checks of each output in the table (:data:`sim.plausibility.CONTRACT_KEYS`)."""
+
+
+def fisheye_keypoints(motion: Motion) -> KeypointRecording:
+    """The controller cameras' keypoints of a test motion (ControllerPose's input)."""
+    from scripts.controllerpose.recording import keypoint_recording
+    from sim.humanoid import humanoid_for
+
+    return keypoint_recording(humanoid_for(motion))
 
 
 def trial_row(result) -> dict[str, float]:
@@ -96,6 +106,7 @@ def fold_rows(fold, setup: VRSetup, methods: Sequence[str], checks: CheckConfig,
             dict(overrides),
             walk_in=walk_in(setup, trial.motion.skeleton, trial.seed) if trackers else None,
             kinect=kinect,
+            fisheye=fisheye_keypoints(trial.motion) if "controllerpose" in methods else None,
         )
         for name in methods:
             result = score_method(build(name, inputs), trial.motion, stream, checks, True)
@@ -116,13 +127,14 @@ def run_leaderboard(
     tune: bool = True,
     progress: Callable[[int, int, str], None] | None = None,
 ) -> dict:
-    """Every method of ``methods`` (default: all registered) on the test trials of
+    """Every method of ``methods`` (default: every registered one that is ready,
+    :func:`~synthesis.methods.ready_methods`) on the test trials of
     ``protocol``.
 
     Returns ``{"protocol", "methods": {name: {column: value}}, "per_class": {class: {name:
     {column: value}}}, "trials", "failed_folds", "skipped"}``.
     """
-    methods = list(methods or METHODS)
+    methods = list(methods or ready_methods())
     all_folds, skipped = folds(trials, protocol)
     if not all_folds:
         raise EvaluationError(f"no class can be evaluated {protocol}: {skipped}")

@@ -15,6 +15,7 @@ from scripts.results import ThresholdResult
 from scripts.scenario import Scenario
 from sim.humanoid import Humanoid
 from synthesis.base import TrackingFrame
+from synthesis.controllerpose.synthesizer import KeypointRecording
 
 
 @dataclass
@@ -31,6 +32,8 @@ class RunContext:
             walk-in calibration.
         kinect_stream: the Kinect skeleton stream (stage ``devices``; None without
             ``[devices] kinect``), MoveBox's input.
+        fisheye_keypoints: the controller cameras' keypoints (stage ``devices``; None
+            without ``[devices] fisheye``), ControllerPose's input.
         synthesised: each method's output on the humanoid, by method name (stage
             ``synthesis``; empty without ``[synthesis]``).
         metrics: thresholded by ``[thresholds]``.
@@ -47,6 +50,7 @@ class RunContext:
     vr_stream: TrackingStream | None = None
     walk_in: TrackingFrame | None = None
     kinect_stream: KinectSkeletonStream | None = None
+    fisheye_keypoints: KeypointRecording | None = None
     synthesised: dict[str, Humanoid] = field(default_factory=dict)
     metrics: dict[str, float] = field(default_factory=dict)
     checks: list[ThresholdResult] = field(default_factory=list)

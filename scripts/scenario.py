@@ -98,10 +98,12 @@ class DevicesSpec:
     (Lighthouse-grade jitter, latency, slow drift). For sweeps, ``latency_s``, ``jitter_m``
     (position, per axis) and ``dropouts_per_s`` (0.5 s bursts of tracking loss) add one
     more model each, after the preset. ``kinect`` (``"kinect-v2"`` or ``"azure-kinect"``)
-    also records the Kinect skeleton stream (30 Hz) that MoveBox runs on."""
+    also records the Kinect skeleton stream (30 Hz) that MoveBox runs on. ``fisheye`` records
+    the controller cameras' 2D keypoints too (ControllerPose's input)."""
 
     vr: bool = True
     kinect: str | None = None
+    fisheye: bool = False
     trackers: bool = False
     noise: str = "realistic"
     latency_s: float = 0.0

@@ -21,6 +21,12 @@ from render_cams.kinect import KinectSkeletonStream
 from render_cams.vr import Attachment
 from synthesis.avatargo import AvatarGo
 from synthesis.base import SynthesisError, Synthesizer, TrackingFrame
+from synthesis.controllerpose.synthesizer import (
+    ControllerPose,
+    KeypointRecording,
+    default_checkpoint,
+    model_missing,
+)
 from synthesis.coolmoves import CoolMoves, Database, Options
 from synthesis.ik_baseline import IKBaseline
 from synthesis.movebox import MoveBox
@@ -48,6 +54,8 @@ class MethodInputs:
             trackers are off.
         kinect: the Kinect skeleton stream of the same take (``[devices] kinect``), for
             MoveBox; None where no Kinect was recorded.
+        fisheye: the controller cameras' keypoints (ControllerPose), or None when the
+            scenario records none (``[devices] fisheye = true``).
     """
 
     database_factory: Callable[[], Database]
@@ -57,6 +65,7 @@ class MethodInputs:
     coolmoves: dict = field(default_factory=dict)
     walk_in: TrackingFrame | None = None
     kinect: KinectSkeletonStream | None = None
+    fisheye: KeypointRecording | None = None
 
     @cached_property
     def database(self) -> Database:
@@ -67,12 +76,19 @@ class MethodInputs:
 class Method:
     """A registered method: its ``name``, a one-line ``summary`` and its ``build``er; the
     CoolMoves variants also carry their :class:`~synthesis.coolmoves.Options` (the
-    ablation switches them one at a time)."""
+    ablation switches them one at a time). ``missing`` says what a method still needs
+    before it can be built (a trained model), or None when it is ready."""
 
     name: str
     summary: str
     build: Callable[[MethodInputs], Synthesizer]
     options: Options | None = None
+    missing: Callable[[], str | None] = lambda: None
+
+
+def ready_methods() -> list[str]:
+    """The registered methods that can be built now (the default set to compare)."""
+    return [name for name, m in METHODS.items() if m.missing() is None]
 
 
 def coolmoves(name: str, summary: str, options: Options) -> Method:
@@ -86,6 +102,17 @@ def coolmoves(name: str, summary: str, options: Options) -> Method:
         return synth
 
     return Method(name, summary, build, options)
+
+
+def controllerpose(inputs: MethodInputs) -> Synthesizer:
+    """ControllerPose (§4.3) with the trained model of :func:`default_checkpoint` on the
+    scored rig, from the controller cameras' keypoints and the VR stream."""
+    if inputs.fisheye is None:
+        raise SynthesisError(
+            "controllerpose needs the controller cameras' keypoints: enable [devices] "
+            "fisheye = true in the scenario"
+        )
+    return ControllerPose(default_checkpoint(), inputs.fisheye, inputs.rig, inputs.user_height_m)
 
 
 def ik_baseline(inputs: MethodInputs) -> Synthesizer:
@@ -158,6 +185,12 @@ METHODS: dict[str, Method] = {
             "movebox",
             "MoveBox: the Kinect skeleton retargeted onto the avatar (§III-A1; [devices] kinect)",
             movebox,
+        ),
+        Method(
+            "controllerpose",
+            "ControllerPose: controller-camera keypoints + VR lifted by a network, IK (§4.3)",
+            controllerpose,
+            missing=model_missing,
         ),
     )
 }

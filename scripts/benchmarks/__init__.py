@@ -24,6 +24,7 @@ BENCHMARKS: dict[str, str] = {
     "control": "control",
     "suite": "suite",
     "dataset": "dataset",
+    "controllerpose": "controllerpose",
 }
 
 

@@ -260,12 +260,34 @@ def register(app: typer.Typer) -> None:
             Path | None,
             typer.Option(help="movebox: a recorded Kinect take folder to retarget and save."),
         ] = None,
+        model: Annotated[
+            Path | None, typer.Option(help="controllerpose: the run folder of the model.")
+        ] = None,
+        data: Annotated[
+            Path | None, typer.Option(help="controllerpose: the dataset folder (test split).")
+        ] = None,
+        no_vr_model: Annotated[
+            Path | None, typer.Option(help="controllerpose: a --no-vr run, for the ablation.")
+        ] = None,
+        frame_stride: Annotated[
+            int, typer.Option(help="controllerpose: every k-th camera frame.")
+        ] = 3,
+        mocap: Annotated[
+            Path | None, typer.Option(help="controllerpose: also held-out real clips here.")
+        ] = None,
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
     ) -> None:
         """Accuracy protocols of a synthesis method, IK baseline beside (CoolMoves §4.1), or
-        ``leaderboard``: every registered method (scripts/leaderboard.py)."""
+        ``leaderboard``: every registered method (scripts/leaderboard.py), or
+        ``controllerpose --model RUN --data DIR`` (scripts/controllerpose/evaluation.py)."""
         from scripts.avatargo_eval import BUILTIN_ACTIVITIES, run_avatargo_eval
+
+        if method == "controllerpose":
+            from scripts.controllerpose.evaluation import evaluate_command
+
+            evaluate_command(model, data, no_vr_model, frame_stride, out, json_out, mocap)
+            return
         from scripts.leaderboard import run_leaderboard
         from synthesis.evaluate import (
             EVALUABLE,

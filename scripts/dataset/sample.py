@@ -1,8 +1,10 @@
 """One sample: a motion window on the humanoid, recorded by one device set.
 
 :func:`make_sample` returns the sample's arrays (WebDataset entries ``<key>.<name>.npy``)
-and its JSON (``<key>.json``): ground truth ``body17`` (T, 17, 3) world metres and ``qpos``
-(T, nq) of the humanoid (:func:`sim.humanoid.humanoid_for`; a foreign rig is retargeted and
+and its JSON (``<key>.json``): ground truth ``body17`` (T, 17, 3) world metres, its joint
+angles ``body17_angles`` (T, 43) (ControllerPose's parameterisation,
+:mod:`avatar_models.body17_angles`: hip as root, world frame) and ``qpos`` (T, nq) of the
+humanoid (:func:`sim.humanoid.humanoid_for`; a foreign rig is retargeted and
 its residual recorded), then the channels of :mod:`.channels` the device set asks for. The
 JSON holds the split and group, the subject's parameters, the provenance (source, clip,
 window start, every seed, package version, config hash) and each channel's description.
@@ -22,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from avatar_models.body17_angles import angles_from_positions
 from avatar_models.rigs import body17_positions
 from scripts.dataset.channels import (
     f32,
@@ -62,8 +65,10 @@ def make_sample(
     motion = window_motion(config, window)
     humanoid = humanoid_for(motion)
     seeds = channel_seeds(spec.seed)
+    body17 = body17_positions(humanoid.motion)
     arrays = {
-        "body17": f32(body17_positions(humanoid.motion)),
+        "body17": f32(body17),
+        "body17_angles": f32(angles_from_positions(body17)[0]),
         "qpos": f32(humanoid.qpos),
     }
     channels: dict[str, Any] = {}

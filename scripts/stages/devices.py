@@ -80,3 +80,8 @@ def run(ctx: RunContext) -> None:
         }
     )
     ctx.output("vr_stream", stream.to_npz(ctx.out_dir / "vr_stream.npz"))
+    if ctx.scenario.devices.fisheye:
+        from scripts.controllerpose.recording import keypoint_recording
+
+        ctx.fisheye_keypoints = keypoint_recording(ctx.humanoid)
+        ctx.info["devices"]["fisheye_frames"] = int(ctx.fisheye_keypoints.time.size)

@@ -81,6 +81,7 @@ def method_inputs(ctx: RunContext, user_height_m: float) -> MethodInputs:
         coolmoves={"foot_contact": ctx.scenario.synthesis.foot_contact},
         walk_in=ctx.walk_in,
         kinect=ctx.kinect_stream,
+        fisheye=ctx.fisheye_keypoints,
     )
 
 

@@ -135,3 +135,16 @@ def test_images_are_deterministic_and_leave_the_other_channels_unchanged(imaged_
 
 def _same(a, b) -> bool:
     return a == b if isinstance(a, bytes) else np.array_equal(a, b)
+
+
+def test_body17_angles_label_reproduces_the_keypoints(first_sample):
+    """The 43-DoF label channel (ControllerPose §4.3) gives back the body17 keypoints by FK
+    (float32 storage: within 1 mm)."""
+    from avatar_models.body17_angles import angles_from_positions, positions_from_angles
+
+    _, arrays, _ = first_sample
+    body17 = arrays["body17"].astype(np.float64)
+    assert arrays["body17_angles"].shape == (len(body17), 43)
+    _, lengths = angles_from_positions(body17)
+    back = positions_from_angles(arrays["body17_angles"].astype(np.float64), lengths)
+    assert np.abs(back - (body17 - body17[:, INDEX["pelvis"] : INDEX["pelvis"] + 1])).max() < 1e-3

@@ -1,0 +1,91 @@
+"""``avatarsim train controllerpose --data DIR --out RUN``: train a method's model on a
+generated dataset (scripts.controllerpose.training)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from scripts.cli_common import (
+    JsonOpt,
+    SeedOpt,
+    check_outputs,
+    console,
+    emit_json,
+    make_app,
+    user_errors,
+)
+
+
+def register(app: typer.Typer) -> None:
+    group = make_app()
+    group.info.help = "Train a method's model on a generated dataset."
+    app.add_typer(group, name="train")
+
+    @group.command()
+    @user_errors
+    def controllerpose(
+        data: Annotated[Path, typer.Option(help="Dataset folder (avatarsim dataset generate).")],
+        out: Annotated[Path, typer.Option(help="Run folder (resumed when it holds this run).")],
+        max_epochs: Annotated[
+            int, typer.Option(help="At most this many epochs (§4.3: 500).")
+        ] = 500,
+        patience: Annotated[
+            int, typer.Option(help="Early stopping: epochs without a better validation loss.")
+        ] = 6,
+        time_budget: Annotated[
+            float, typer.Option(help="Stop after the epoch that passes this many seconds.")
+        ] = 1200.0,
+        position_weight: Annotated[
+            float,
+            typer.Option(
+                help="Weight of a position loss through FK (beyond the paper; 0: angles only)."
+            ),
+        ] = 0.0,
+        vr: Annotated[
+            bool, typer.Option(help="Use the 15 VR features (--no-vr: the §5.3 ablation).")
+        ] = True,
+        frame_stride: Annotated[
+            int, typer.Option(help="Every k-th camera frame (30 Hz) of each sample.")
+        ] = 3,
+        width: Annotated[int, typer.Option(help="Trunk width.")] = 256,
+        blocks: Annotated[int, typer.Option(help="Residual blocks.")] = 2,
+        threads: Annotated[int, typer.Option(help="torch CPU threads.")] = 1,
+        seed: SeedOpt = 0,
+        json_out: JsonOpt = None,
+    ) -> None:
+        """Train the ControllerPose lifting network (§4.3) on CPU: curves in RUN/loss.png,
+        checkpoint in RUN/checkpoint.pt (resumable), summary in RUN/train.json."""
+        from avatar_models.errors import AvatarsimError
+        from scripts.controllerpose.training import run_training
+        from synthesis.controllerpose.network import NetConfig
+        from synthesis.controllerpose.train import TrainConfig
+
+        for name, value in (
+            ("--max-epochs", max_epochs),
+            ("--frame-stride", frame_stride),
+            ("--width", width),
+            ("--threads", threads),
+        ):
+            if value < 1:
+                raise AvatarsimError(f"{name} must be at least 1, got {value}")
+        check_outputs(json_out=json_out)
+        net = NetConfig(width=width, blocks=blocks, use_vr=vr)
+        config = TrainConfig(
+            max_epochs=max_epochs,
+            patience=patience,
+            position_weight=position_weight,
+            time_budget_s=time_budget,
+            seed=seed,
+            threads=threads,
+        )
+        summary = run_training(data, out, net, config, frame_stride, console.print)
+        best = summary["best_val"]
+        console.print(
+            f"{out}: {summary['epochs']} epochs in {summary['train_s']:.0f} s, best epoch "
+            f"{summary['best_epoch']} (val angle mse {best['val_angle_mse']:.4g} rad², "
+            f"position rmse {best['val_position_mse'] ** 0.5 * 100:.2f} cm)"
+        )
+        emit_json(json_out, summary)

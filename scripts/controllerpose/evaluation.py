@@ -1,0 +1,165 @@
+"""``avatarsim eval controllerpose --model RUN --data DIR``: §5.3 accuracy on a dataset split.
+
+On the held-out split (``test``: subjects that never reached train), in §5.3's normalised
+frame (:func:`synthesis.controllerpose.evaluate.normalise`): the model's mean joint error
+overall and without hip and torso, each with its SD, per joint (a Fig. 9-like chart,
+``per_joint.png``), the nearest-neighbour baseline on the same features (database: the
+train split), and, given ``--no-vr-model RUN`` (a model trained with ``--no-vr``), the
+§5.3 ablation without VR features and its increase over the full model (paper: +25.5%).
+Given ``--mocap FOLDER``, the same on held-out real clips (Bandai, CMU) rendered through
+the simulated devices (:func:`scripts.controllerpose.data.mocap_examples`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from avatar_models.body17 import BODY17
+from avatar_models.errors import AvatarsimError
+from avatar_models.fileio import write_json
+from scripts.controllerpose.data import load_examples, mocap_examples
+from scripts.controllerpose.figures import plt, save_png
+from synthesis.controllerpose.checkpoint import Checkpoint, load
+from synthesis.controllerpose.evaluate import (
+    joint_errors,
+    model_positions,
+    nearest_neighbour_positions,
+    normalise,
+    summary,
+)
+from synthesis.controllerpose.examples import Examples
+
+
+class EvaluationError(AvatarsimError, ValueError):
+    """Options of ``eval controllerpose`` that cannot work."""
+
+
+MOCAP_SECONDS = 4.0
+PAPER = {"mean_cm": 6.98, "sd_cm": 4.2, "limbs_mean_cm": 8.59, "no_vr_mean_cm": 8.76}
+
+
+def plot_per_joint(results: dict[str, dict], path: Path) -> None:
+    """Mean error per joint with SD bars, one bar group per model (Fig. 9, right)."""
+    fig, ax = plt.subplots(figsize=(12, 4))
+    width = 0.8 / len(results)
+    x = np.arange(len(BODY17))
+    for k, (name, res) in enumerate(results.items()):
+        means = [res["per_joint_cm"][n] for n in BODY17]
+        sds = [res["per_joint_sd_cm"][n] for n in BODY17]
+        ax.bar(x + k * width, means, width, yerr=sds, label=name, capsize=2)
+    ax.set_xticks(x + 0.4 - width / 2, BODY17, rotation=45, ha="right")
+    ax.set_ylabel("mean 3D error (cm), §5.3 normalised")
+    ax.legend()
+    save_png(fig, path)
+
+
+def split_results(
+    checkpoint: Checkpoint,
+    ablation: Checkpoint | None,
+    test: Examples,
+    train: Examples,
+) -> dict[str, dict]:
+    """The model, the nearest-neighbour baseline and the ablation on ``test``."""
+    truth = normalise(test.positions.astype(np.float64), test.height)
+    results = {
+        "controllerpose": summary(
+            joint_errors(normalise(model_positions(checkpoint, test), test.height), truth)
+        ),
+        "nearest-neighbour": summary(
+            joint_errors(nearest_neighbour_positions(checkpoint, train, test), truth)
+        ),
+    }
+    if ablation is not None:
+        results["controllerpose-no-vr"] = summary(
+            joint_errors(normalise(model_positions(ablation, test), test.height), truth)
+        )
+    return results
+
+
+def run_evaluation(
+    model: Path,
+    data: Path,
+    out: Path,
+    ablation: Path | None,
+    frame_stride: int,
+    mocap: Path | None = None,
+    mocap_clips: int = 4,
+) -> dict[str, Any]:
+    """Evaluates (module docstring), writes ``out/eval.json`` and ``out/per_joint.png``."""
+    checkpoint = load(model)
+    ablation_checkpoint = load(ablation) if ablation is not None else None
+    test = load_examples(data, "test", frame_stride)
+    test.features.check_finite(f"{data} test split")
+    train = load_examples(data, "train", frame_stride)
+    results = split_results(checkpoint, ablation_checkpoint, test, train)
+    real = None
+    if mocap is not None:
+        clips = mocap_examples(mocap, mocap_clips, MOCAP_SECONDS)
+        clips.features.check_finite(f"{mocap} clips")
+        real = split_results(
+            checkpoint,
+            ablation_checkpoint,
+            clips.take(np.arange(0, len(clips), frame_stride)),
+            train,
+        )
+    full = results["controllerpose"]["mean_cm"]
+    report = {
+        "model": str(model),
+        "data": str(data),
+        "split": "test (held-out subjects)",
+        "frame_stride": frame_stride,
+        "results": results,
+        "no_vr_increase_pct": (
+            100.0 * (results["controllerpose-no-vr"]["mean_cm"] / full - 1.0)
+            if ablation_checkpoint is not None
+            else None
+        ),
+        "real_mocap": real,
+        "real_mocap_folder": None if mocap is None else str(mocap),
+        "paper": PAPER,
+    }
+    out.mkdir(parents=True, exist_ok=True)
+    plot_per_joint(results, out / "per_joint.png")
+    write_json(out / "eval.json", report)
+    return report
+
+
+def evaluate_command(
+    model: Path | None,
+    data: Path | None,
+    no_vr_model: Path | None,
+    frame_stride: int,
+    out: Path,
+    json_out: Path | None,
+    mocap: Path | None = None,
+) -> None:
+    """``avatarsim eval controllerpose``: checks the options, evaluates, prints a table."""
+    from rich.table import Table
+
+    from scripts.cli_common import check_outputs, console, emit_json
+
+    if model is None or data is None:
+        raise EvaluationError("eval controllerpose needs --model RUN and --data DIR")
+    if frame_stride < 1:
+        raise EvaluationError(f"--frame-stride must be at least 1, got {frame_stride}")
+    check_outputs(json_out=json_out, out=out)
+    report = run_evaluation(model, data, out, no_vr_model, frame_stride, mocap)
+    table = Table(title=f"ControllerPose, §5.3 normalised, test: {report['split']}")
+    for column in ("test", "method", "mean cm (SD)", "without hip+torso cm (SD)", "frames"):
+        table.add_column(column)
+    for split, results in (("dataset", report["results"]), ("real mocap", report["real_mocap"])):
+        for name, res in (results or {}).items():
+            table.add_row(
+                split,
+                name,
+                f"{res['mean_cm']:.2f} ({res['sd_cm']:.2f})",
+                f"{res['limbs_mean_cm']:.2f} ({res['limbs_sd_cm']:.2f})",
+                str(res["frames"]),
+            )
+    console.print(table)
+    if report["no_vr_increase_pct"] is not None:
+        console.print(f"without VR: {report['no_vr_increase_pct']:+.1f}% (paper: +25.5%)")
+    emit_json(json_out, report)

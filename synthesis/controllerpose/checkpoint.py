@@ -1,0 +1,125 @@
+"""ControllerPose checkpoints: one file that holds what inference and resuming need.
+
+``checkpoint.pt`` (``torch.save``, written atomically) holds the feature layout
+(:data:`~.features.LAYOUT`), the network's config and weights (the best on validation so
+far, and the latest with the optimiser for resuming), the feature normaliser, the bone
+lengths template, the training config and seed, the dataset manifest's sha256, the epoch
+and the loss history. :func:`load` refuses a file from another feature layout.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+
+from avatar_models import AvatarsimError
+from synthesis.controllerpose.features import LAYOUT
+from synthesis.controllerpose.network import LiftingNet, NetConfig
+from synthesis.controllerpose.normaliser import Normaliser
+
+FILE = "checkpoint.pt"
+
+
+class CheckpointError(AvatarsimError, ValueError):
+    """A checkpoint that is missing, unreadable or from another feature layout."""
+
+
+@dataclass
+class Checkpoint:
+    """A trained (or training) model and what came with it (module docstring).
+
+    Attributes:
+        net: the network's sizes.
+        best_weights: the weights with the lowest validation loss so far.
+        normaliser: the features' normaliser.
+        template_lengths: ``(17,)`` mean bone lengths per metre of standing height.
+        train: the training config (a dict; see :class:`~.train.TrainConfig`).
+        manifest_sha256: the training dataset's manifest hash.
+        epoch: epochs done.
+        history: per epoch: train and validation losses, seconds.
+        resume: latest weights, optimiser and scheduler state, and early-stopping counters.
+    """
+
+    net: NetConfig
+    best_weights: dict[str, torch.Tensor]
+    normaliser: Normaliser
+    template_lengths: np.ndarray
+    train: dict[str, Any]
+    manifest_sha256: str
+    epoch: int
+    history: list[dict[str, float]]
+    resume: dict[str, Any]
+
+    def model(self) -> LiftingNet:
+        """The best network, in eval mode."""
+        model = LiftingNet(self.net)
+        model.load_state_dict(self.best_weights)
+        return model.eval()
+
+    def save(self, folder: Path) -> Path:
+        """Writes ``folder/checkpoint.pt`` atomically; returns its path."""
+        folder.mkdir(parents=True, exist_ok=True)
+        payload = {
+            "layout": LAYOUT,
+            "net": self.net.as_dict(),
+            "best_weights": self.best_weights,
+            "normaliser": self.normaliser.state(),
+            "template_lengths": self.template_lengths,
+            "train": self.train,
+            "seed": self.train.get("seed"),
+            "manifest_sha256": self.manifest_sha256,
+            "epoch": self.epoch,
+            "history": self.history,
+            "resume": self.resume,
+        }
+        path = folder / FILE
+        fd, tmp = tempfile.mkstemp(dir=folder, prefix=".checkpoint-", suffix=".tmp")
+        os.close(fd)
+        try:
+            torch.save(payload, tmp)
+            os.replace(tmp, path)
+        finally:
+            if os.path.exists(tmp):
+                os.unlink(tmp)
+        return path
+
+
+def load(folder: str | Path) -> Checkpoint:
+    """The checkpoint in run folder ``folder`` (or the file itself).
+
+    Raises:
+        CheckpointError: no checkpoint, unreadable, or another feature layout.
+    """
+    path = Path(folder)
+    path = path / FILE if path.is_dir() else path
+    if not path.is_file():
+        raise CheckpointError(
+            f"no ControllerPose checkpoint at {path} (train one: avatarsim train controllerpose)"
+        )
+    try:
+        payload = torch.load(path, map_location="cpu", weights_only=False)
+    except Exception as exc:  # torch raises many kinds for a damaged file
+        raise CheckpointError(f"{path}: not a readable checkpoint ({exc})") from exc
+    if not isinstance(payload, dict) or payload.get("layout") != LAYOUT:
+        found = payload.get("layout") if isinstance(payload, dict) else None
+        raise CheckpointError(
+            f"{path}: feature layout {found} is not this version's {LAYOUT}; retrain with "
+            "avatarsim train controllerpose"
+        )
+    return Checkpoint(
+        NetConfig(**payload["net"]),
+        payload["best_weights"],
+        Normaliser(**payload["normaliser"]),
+        np.asarray(payload["template_lengths"]),
+        payload["train"],
+        payload["manifest_sha256"],
+        payload["epoch"],
+        payload["history"],
+        payload["resume"],
+    )

@@ -1,0 +1,91 @@
+"""``avatarsim train controllerpose`` and ``avatarsim eval controllerpose``: what they write,
+resume, and the bad inputs that exit 2 before any work."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import torch
+from typer.testing import CliRunner
+
+from scripts.cli import app
+from synthesis.controllerpose.checkpoint import load
+from tests.scripts.controllerpose.conftest import tiny_dataset
+
+runner = CliRunner()
+
+
+def test_train_writes_checkpoint_curves_and_summary(cp_run):
+    summary = json.loads((cp_run / "train.json").read_text())
+    assert summary["epochs"] == 2 and summary["examples"]["train"] > 0
+    assert (cp_run / "loss.png").read_bytes()[:4] == b"\x89PNG"
+    checkpoint = load(cp_run)
+    assert checkpoint.manifest_sha256 == summary["manifest_sha256"]
+    assert checkpoint.train["seed"] == 0
+
+
+def test_train_resumes_a_finished_run_without_retraining(cp_run, cp_dataset):
+    before = load(cp_run).best_weights
+    result = runner.invoke(
+        app,
+        ["train", "controllerpose", "--data", str(cp_dataset), "--out", str(cp_run),
+         "--max-epochs", "2", "--width", "32", "--blocks", "1"],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    assert json.loads((cp_run / "train.json").read_text())["resumed"]
+    after = load(cp_run).best_weights
+    assert all(torch.equal(before[k], after[k]) for k in before)
+
+
+def test_eval_reports_model_baseline_and_ablation(cp_run, cp_dataset, tmp_path):
+    result = runner.invoke(
+        app,
+        ["eval", "controllerpose", "--model", str(cp_run), "--data", str(cp_dataset),
+         "--no-vr-model", str(cp_run), "--out", str(tmp_path / "eval")],
+    )  # fmt: skip
+    assert result.exit_code == 0, result.output
+    report = json.loads((tmp_path / "eval" / "eval.json").read_text())
+    assert set(report["results"]) == {"controllerpose", "nearest-neighbour", "controllerpose-no-vr"}
+    full = report["results"]["controllerpose"]
+    assert np.isfinite(full["mean_cm"]) and full["per_joint_cm"]["pelvis"] < 1e-6
+
+
+def test_a_dataset_without_keypoints_exits_2(tmp_path):
+    no_fisheye = tiny_dataset(tmp_path, [{"name": "vr", "fisheye": False, "physics": False}])
+    result = runner.invoke(
+        app, ["train", "controllerpose", "--data", str(no_fisheye), "--out", str(tmp_path / "r")]
+    )
+    assert result.exit_code == 2 and "fisheye" in result.output
+    assert not (tmp_path / "r").exists()
+
+
+def test_a_checkpoint_of_another_feature_layout_exits_2(cp_run, cp_dataset, tmp_path):
+    payload = torch.load(cp_run / "checkpoint.pt", weights_only=False)
+    payload["layout"] = {**payload["layout"], "skeleton_slots": 2}
+    (tmp_path / "old").mkdir()
+    torch.save(payload, tmp_path / "old" / "checkpoint.pt")
+    result = runner.invoke(
+        app,
+        ["eval", "controllerpose", "--model", str(tmp_path / "old"), "--data", str(cp_dataset),
+         "--out", str(tmp_path / "eval")],
+    )  # fmt: skip
+    assert result.exit_code == 2 and "feature layout" in result.output
+
+
+def test_nan_in_the_features_exits_2(cp_dataset, tmp_path, monkeypatch):
+    import scripts.controllerpose.training as training
+
+    real = training.load_examples
+
+    def with_nan(root, split, stride):
+        examples = real(root, split, stride)
+        examples.features.skeletons[0, 0, 5] = np.nan
+        return examples
+
+    monkeypatch.setattr(training, "load_examples", with_nan)
+    result = runner.invoke(
+        app, ["train", "controllerpose", "--data", str(cp_dataset), "--out", str(tmp_path / "r")]
+    )
+    assert result.exit_code == 2 and "non-finite" in result.output
+    assert not (tmp_path / "r" / "checkpoint.pt").exists()

@@ -1,0 +1,59 @@
+"""ControllerPose as a registered method on a real clip of each source (CMU, Bandai
+dataset-1 and dataset-2), rendered through the simulated devices, with the tiny model the
+session trained: it runs on the VR stream's clock and its output is finite."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from avatar_models.formats.bvh import read_bvh
+from avatar_models.measure import standing_height
+from render_cams.vr import HEADSET_AND_CONTROLLERS, VRSetup
+from scripts.controllerpose.recording import keypoint_recording
+from scripts.stages.devices import REALISTIC_NOISE
+from sim.humanoid import humanoid_for
+from synthesis.base import on_clock
+from synthesis.controllerpose.synthesizer import MODEL_ENV
+from synthesis.methods import MethodInputs, build
+
+CLIPS = {
+    "cmu": "cmu/09_01.bvh",
+    "bandai-1": "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh",
+    "bandai-2": "bandai/dataset-2/data/dataset-2_wave-right-hand_youthful_001.bvh",
+}
+SECONDS = 1.0
+
+
+@pytest.mark.mocap
+@pytest.mark.slow
+@pytest.mark.parametrize("source", sorted(CLIPS))
+def test_controllerpose_runs_on_a_real_clip(source, mocap_dir, cp_run, monkeypatch):
+    motion = read_bvh(mocap_dir / CLIPS[source])
+    motion = motion[: int(SECONDS * motion.fps)]
+    humanoid = humanoid_for(motion)
+    stream = VRSetup(devices=HEADSET_AND_CONTROLLERS, noise=REALISTIC_NOISE).sample(
+        humanoid.motion, seed=0
+    )
+    monkeypatch.setenv(MODEL_ENV, str(cp_run))
+    inputs = MethodInputs(
+        database_factory=list,
+        user_height_m=standing_height(humanoid.motion),
+        rig=humanoid.body.skeleton,
+        fisheye=keypoint_recording(humanoid),
+    )
+    output = build("controllerpose", inputs).run(stream)
+    assert output.n_frames == on_clock(stream).n_samples
+    assert np.isfinite(output.local_rot).all() and np.isfinite(output.root_pos).all()
+    head_height = output.global_positions()[:, 0, 2]
+    assert np.isfinite(head_height).all()
+
+
+def test_without_the_cameras_the_method_says_which_device_to_enable(monkeypatch):
+    from avatar_models.generator import generate
+    from synthesis.base import SynthesisError
+
+    rig = generate("walk", duration_s=0.2, fps=30.0).skeleton
+    inputs = MethodInputs(database_factory=list, user_height_m=1.75, rig=rig)
+    with pytest.raises(SynthesisError, match=r"\[devices\] fisheye"):
+        build("controllerpose", inputs)
