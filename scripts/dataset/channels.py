@@ -36,6 +36,7 @@ from render_cams.device import motion_at_rate
 from render_cams.fisheye.detector import KeypointDetector
 from render_cams.fisheye.device import CAMERA_RATE_HZ, FisheyeRig
 from render_cams.fisheye.keypoints import confidence, project_joints, world_to_camera
+from render_cams.fisheye.pose2d import controller_views
 from render_cams.fisheye.rig import camera_poses, controller_cameras, inside_body
 from render_cams.kinect import Kinect
 from render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
@@ -83,7 +84,17 @@ def fisheye_channel(humanoid: Humanoid, seed: int) -> Channel:
     ``fisheye_detected`` (Tc, C, 17) bool, ``fisheye_uv_projected`` (Tc, C, 17, 2) exact
     pixels, ``fisheye_in_view`` (Tc, C, 17) bool, ``fisheye_lens_covered`` (Tc, C) bool,
     ``fisheye_w2c`` (Tc, C, 4, 4) world-to-camera (OpenCV axes); intrinsics and the detector
-    model in the JSON. Projected, not rendered (module docstring)."""
+    model in the JSON. Projected, not rendered (module docstring).
+
+    Also the 2D poses ControllerPose lifts (§4.3; :func:`render_cams.fisheye.pose2d.
+    controller_views`): per controller, the detector's report on its composite and on the
+    torso-normal view built from that report, as ``V`` = 2 x controllers views in the order
+    of ``meta["views"]`` (``"<controller>/composite"``, ``"<controller>/torso"``):
+    ``fisheye_view_uv`` (Tc, V, 17, 2) pixels of that view ((0, 0) where not detected),
+    ``fisheye_view_conf`` (Tc, V, 17), ``fisheye_view_detected`` (Tc, V, 17) bool. A camera
+    whose lens the body covers is left out of its composite (no image filter runs on
+    projected keypoints). Drawn from their own generator, so the per-camera detections
+    above are those of a dataset without views."""
     rig = FisheyeRig()
     sampled = motion_at_rate(humanoid.motion, rig.rate_hz)
     cameras = controller_cameras(rig.controllers, rig.mount)
@@ -99,6 +110,12 @@ def fisheye_channel(humanoid: Humanoid, seed: int) -> Channel:
     detector = KeypointDetector()
     score = confidence(rig.model, uv, in_view)
     detection = detector.detect(uv, in_view, in_view, score, np.random.default_rng(seed))
+    views = controller_views(
+        rig.model, cameras, uv, in_view, in_view, score, ~covered, detector,
+        np.random.default_rng([seed, 1]),
+    )  # fmt: skip
+    view_names = [f"{c}/{kind}" for c in views for kind in ("composite", "torso")]
+    reports = [d for v in views.values() for d in (v.composite_detection, v.torso_detection)]
     arrays = {
         "fisheye_uv": f32(detection.uv),
         "fisheye_conf": f32(detection.confidence),
@@ -107,6 +124,9 @@ def fisheye_channel(humanoid: Humanoid, seed: int) -> Channel:
         "fisheye_in_view": in_view,
         "fisheye_lens_covered": np.ascontiguousarray(covered, dtype=bool),
         "fisheye_w2c": f32(world_to_camera(poses)),
+        "fisheye_view_uv": f32(np.stack([d.uv for d in reports], axis=1)),
+        "fisheye_view_conf": f32(np.stack([d.confidence for d in reports], axis=1)),
+        "fisheye_view_detected": np.stack([d.detected for d in reports], axis=1),
     }
     meta = {
         "rate_hz": rig.rate_hz,
@@ -116,6 +136,10 @@ def fisheye_channel(humanoid: Humanoid, seed: int) -> Channel:
         "detected by the detector error model",
         "detector": asdict(detector),
         "seed": seed,
+        "views": view_names,
+        "view_sizes": {
+            c: [v.params.cylinder.width, v.params.cylinder.height] for c, v in views.items()
+        },
     }
     return arrays, meta
 

@@ -148,3 +148,33 @@ def test_body17_angles_label_reproduces_the_keypoints(first_sample):
     _, lengths = angles_from_positions(body17)
     back = positions_from_angles(arrays["body17_angles"].astype(np.float64), lengths)
     assert np.abs(back - (body17 - body17[:, INDEX["pelvis"] : INDEX["pelvis"] + 1])).max() < 1e-3
+
+
+def test_composite_and_torso_views_are_detections_inside_their_images(first_sample):
+    """ControllerPose's four 2D poses (§4.3): each controller's composite and torso-normal
+    view, reported by the detector: confidences in (0, 1] exactly where detected, pixels
+    inside the view, and a body that both views see (a waving or squatting user in front
+    of the controllers)."""
+    _, arrays, meta = first_sample
+    fisheye = meta["channels"]["fisheye"]
+    assert fisheye["views"] == [
+        f"{side}_controller/{kind}" for side in ("left", "right") for kind in ("composite", "torso")
+    ]
+    uv, conf = arrays["fisheye_view_uv"], arrays["fisheye_view_conf"]
+    found = arrays["fisheye_view_detected"]
+    assert uv.shape == (meta["frames"], 4, 17, 2) and found.dtype == bool
+    assert np.all((conf[found] > 0) & (conf[found] <= 1)) and np.all(conf[~found] == 0)
+    assert np.all(uv[~found] == 0)
+    torso = [INDEX[j] for j in ("l_shoulder", "r_shoulder", "l_hip", "r_hip")]
+    for v, name in enumerate(fisheye["views"]):
+        width, height = fisheye["view_sizes"][name.split("/")[0]]
+        seen = found[:, v]
+        inside = (uv[:, v, :, 0] > -0.5) & (uv[:, v, :, 0] < width - 0.5)
+        inside &= (uv[:, v, :, 1] > -0.5) & (uv[:, v, :, 1] < height - 0.5)
+        # The detector's noise may push a joint at the edge a little outside.
+        assert inside[seen].mean() > 0.95, name
+        if name.endswith("/composite"):
+            assert seen.any(axis=1).mean() > 0.5, name  # the user is in front of the hands
+            # A torso view exists only where the composite reported all four torso corners.
+            corners = seen[:, torso].all(axis=1)
+            assert not np.any(found[:, v + 1].any(axis=1) & ~corners), name
