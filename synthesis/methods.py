@@ -56,12 +56,15 @@ class MethodInputs:
 class Method:
     """A registered method: its ``name``, a one-line ``summary`` and its ``build``er; the
     CoolMoves variants also carry their :class:`~synthesis.coolmoves.Options` (the
-    ablation switches them one at a time)."""
+    ablation switches them one at a time). ``sensors`` names the :class:`MethodInputs`
+    fields beyond the VR stream that the builder reads (e.g. ``("kinect",)``): whoever
+    runs the method by name (the leaderboard) records them for it."""
 
     name: str
     summary: str
     build: Callable[[MethodInputs], Synthesizer]
     options: Options | None = None
+    sensors: tuple[str, ...] = ()
 
 
 def coolmoves(name: str, summary: str, options: Options) -> Method:

@@ -11,9 +11,11 @@ matches: when even the nearest window lies beyond it (an input unlike every data
 e.g. tracking with centimetres of jitter, whose accelerations no clean recording has), the k
 nearest are blended all the same, as the paper's pipeline always produces a pose (§3.1.4).
 Dropping every match there froze the output in its last pose (hand correlation exactly 0
-on 2 cm jitter, a real CMU run and a Bandai wave against generated databases). The accuracy protocols choose it per fold on a
-validation split of the fold's training data (:mod:`synthesis.evaluate.validation`);
-:data:`MAX_DISTANCE` is the default elsewhere (scenarios, benchmarks, a plain ``CoolMoves``).
+on 2 cm jitter, a real CMU run and a Bandai wave against generated databases).
+
+The accuracy protocols choose the threshold per fold on a validation split of the fold's
+training data (:mod:`synthesis.evaluate.validation`); :data:`MAX_DISTANCE` is the default
+elsewhere (scenarios, benchmarks, a plain ``CoolMoves``).
 """
 
 from __future__ import annotations
