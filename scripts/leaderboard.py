@@ -4,8 +4,10 @@ accuracy, for the physics of its output and for speed (``avatarsim eval leaderbo
 Per fold of the protocol (:func:`synthesis.evaluate.folds`): the database of the fold's
 training trials (built once, shared by every CoolMoves variant), the distance threshold
 chosen on the training data (:mod:`synthesis.evaluate.validation`), and per test trial one
-VR stream (and, for MoveBox, one Kinect V2 skeleton stream) that every method
-(:data:`synthesis.methods.METHODS`) runs on, through
+VR stream that every method (:data:`synthesis.methods.METHODS`) runs on, plus one recording
+of each further sensor a selected method declares (``Method.sensors``, recorded by
+:data:`RECORDERS`: MoveBox's Kinect V2 skeleton stream, ControllerPose's controller-camera
+keypoints), and AvatarGo's walk-in T-pose sample of the six VR devices, through
 :func:`scripts.method_score.score_method` (timed ``step`` calls included). A method's numbers
 are means over the trials of a class, then over classes (each class counts once, as the
 paper averages over activities); latency percentiles are those of all steps of a trial,
@@ -65,12 +67,38 @@ PHYSICS = (
 """The physics checks of each output in the table (:data:`sim.plausibility.CONTRACT_KEYS`)."""
 
 
-def fisheye_keypoints(motion: Motion) -> KeypointRecording:
+def fisheye_keypoints(motion: Motion, seed: int) -> KeypointRecording:
     """The controller cameras' keypoints of a test motion (ControllerPose's input)."""
     from scripts.controllerpose.recording import keypoint_recording
     from sim.humanoid import humanoid_for
 
-    return keypoint_recording(humanoid_for(motion))
+    return keypoint_recording(humanoid_for(motion), seed)
+
+
+RECORDERS: dict[str, Callable[[Motion, int], object]] = {
+    "kinect": lambda truth, seed: filmed(truth, seed=seed),
+    "fisheye": fisheye_keypoints,
+}
+"""How to record a sensor beyond the VR stream for a test motion, by the
+:class:`~synthesis.methods.MethodInputs` field it fills: ``(truth, seed) -> recording``
+(seeded like the trial's VR stream). A method that declares a sensor in ``Method.sensors``
+needs an entry here to be on the leaderboard."""
+
+
+def sensors_of(methods: Sequence[str]) -> list[str]:
+    """The sensors beyond the VR stream that ``methods`` read, in first-declared order.
+
+    Raises:
+        EvaluationError: a method reads a sensor no :data:`RECORDERS` entry records.
+    """
+    needed = list(dict.fromkeys(s for name in methods for s in METHODS[name].sensors))
+    missing = [s for s in needed if s not in RECORDERS]
+    if missing:
+        raise EvaluationError(
+            f"no recorder for sensor(s) {', '.join(missing)} (scripts.leaderboard.RECORDERS); "
+            "leave out the methods that read them"
+        )
+    return needed
 
 
 def trial_row(result) -> dict[str, float]:
@@ -91,13 +119,13 @@ def fold_rows(fold, setup: VRSetup, methods: Sequence[str], checks: CheckConfig,
     if tune:
         overrides["max_distance"] = choose_max_distance(fold.train, fold.protocol, coolmoves, setup)
     database = cache(lambda: database_for(fold.train))
+    sensors = sensors_of(methods)
     out = []
     trackers = set(FULL_BODY) <= set(setup.devices)
     for trial in fold.test:
         stream = setup.sample(trial.motion, seed=trial.seed)
         rig, calibration = ik_rig_for(database().skeleton, trial.motion, setup)
-        # MoveBox reads a Kinect V2 of the same take (seeded like the VR stream).
-        kinect = filmed(trial.motion, seed=trial.seed) if "movebox" in methods else None
+        recordings = {s: RECORDERS[s](trial.motion, trial.seed) for s in sensors}
         inputs = MethodInputs(
             database,
             standing_height(trial.motion),
@@ -105,8 +133,7 @@ def fold_rows(fold, setup: VRSetup, methods: Sequence[str], checks: CheckConfig,
             calibration,
             dict(overrides),
             walk_in=walk_in(setup, trial.motion.skeleton, trial.seed) if trackers else None,
-            kinect=kinect,
-            fisheye=fisheye_keypoints(trial.motion) if "controllerpose" in methods else None,
+            **recordings,
         )
         for name in methods:
             result = score_method(build(name, inputs), trial.motion, stream, checks, True)
@@ -135,6 +162,7 @@ def run_leaderboard(
     {column: value}}}, "trials", "failed_folds", "skipped"}``.
     """
     methods = list(methods or ready_methods())
+    sensors_of(methods)  # every sensor can be recorded, checked before any work
     all_folds, skipped = folds(trials, protocol)
     if not all_folds:
         raise EvaluationError(f"no class can be evaluated {protocol}: {skipped}")
@@ -188,15 +216,26 @@ def write_plot(board: dict, path: Path) -> Path:
     return path
 
 
+def _rows(methods: dict[str, dict]) -> list[list[str]]:
+    return [[html.escape(name)] + [f"{s[k]:.3g}" for k in COLUMNS] for name, s in methods.items()]
+
+
 def render_page(board: dict, plot: Path) -> str:
-    """The leaderboard as a self-contained HTML page (table and plot)."""
-    rows = [
-        [html.escape(name)] + [f"{s[k]:.3g}" for k in COLUMNS]
-        for name, s in board["methods"].items()
-    ]
+    """The leaderboard as a self-contained HTML page: the table over classes, the plot, and
+    one table per class."""
+    header = ["method", *COLUMNS.values()]
+    per_class = "".join(
+        f"<h3>{html.escape(cls)}</h3>" + table_html(_rows(methods), header)
+        for cls, methods in board["per_class"].items()
+    )
     body = (
         f"<h1>Leaderboard: {html.escape(board['protocol'])}, {board['trials']} test trials</h1>"
-        + table_html(rows, ["method", *COLUMNS.values()])
+        + "<p>Errors in cm (body17 joints), hand r: input-output hand correlation; physics of "
+        + "each output on the humanoid; step latency of the streaming <code>step</code>. Means "
+        + "over the trials of a class, then over classes.</p>"
+        + table_html(_rows(board["methods"]), header)
         + image_html(plot, "Accuracy against physical plausibility, per method")
+        + "<h2>Per class</h2>"
+        + per_class
     )
     return page(f"avatarsim leaderboard {board['protocol']}", body)

@@ -80,11 +80,16 @@ CADENCE_STEPS_PER_S = (1.1, 0.55)
 """Step frequency ``a + b v`` (steps/s) at horizontal speed ``v`` (m/s): about 1.8 steps/s
 walking at 1.3 m/s and 2.9 steps/s running at 3.3 m/s (Dean 1965; Cavanagh & Kram 1989
 report 2.7-3.0 steps/s at 3-4 m/s)."""
-MAX_SWING_S = 0.2
-"""Longest swing of one foot: a step takes ``min(1 / cadence, MAX_SWING_S)``. Tuned on the
-generator's cross-subject run and dribble (0.4 s, a biomechanical swing time, left a
-running body's feet behind: 23.8 vs 14.8 cm full-body on run; 0.25 s is VRIK's 4 steps/s).
-Quick swings are what one-foot-at-a-time stepping needs to keep up without a flight
+VRIK_STEP_SPEED = 3.0
+"""VRIK's default ``Locomotion.stepSpeed`` (FinalIK ``IKSolverVRLocomotion``): a step's progress
+advances by ``stepSpeed * dt``, so a step lasts ``1 / stepSpeed`` s, and each step draws its
+speed uniformly from ``[stepSpeed, 1.5 stepSpeed]``, i.e. 0.22-0.33 s per step."""
+MAX_SWING_S = 1.0 / (1.5 * VRIK_STEP_SPEED)
+"""Longest swing of one foot: a step takes ``min(1 / cadence, MAX_SWING_S)``, VRIK's quickest
+step (0.222 s, :data:`VRIK_STEP_SPEED`; deterministic, where VRIK draws at random). Not tuned:
+it replaced 0.2 s, which had been chosen on the generator's cross-subject test folds (0.4 s, a
+biomechanical swing time, left a running body's feet behind: 23.8 vs 14.8 cm full-body on
+run). Quick swings are what one-foot-at-a-time stepping needs to keep up without a flight
 phase."""
 STEP_HEIGHT_M = (0.05, 0.1, 0.35)
 """Apex of the foot's arc above its planted height: ``clip(b v, lo, hi)`` as ``(lo, b, hi)``

@@ -76,13 +76,16 @@ class MethodInputs:
 class Method:
     """A registered method: its ``name``, a one-line ``summary`` and its ``build``er; the
     CoolMoves variants also carry their :class:`~synthesis.coolmoves.Options` (the
-    ablation switches them one at a time). ``missing`` says what a method still needs
-    before it can be built (a trained model), or None when it is ready."""
+    ablation switches them one at a time). ``sensors`` names the :class:`MethodInputs`
+    fields beyond the VR stream that the builder reads (e.g. ``("kinect",)``): whoever
+    runs the method by name (the leaderboard) records them for it. ``missing`` says what a
+    method still needs before it can be built (a trained model), or None when it is ready."""
 
     name: str
     summary: str
     build: Callable[[MethodInputs], Synthesizer]
     options: Options | None = None
+    sensors: tuple[str, ...] = ()
     missing: Callable[[], str | None] = lambda: None
 
 
@@ -185,11 +188,13 @@ METHODS: dict[str, Method] = {
             "movebox",
             "MoveBox: the Kinect skeleton retargeted onto the avatar (§III-A1; [devices] kinect)",
             movebox,
+            sensors=("kinect",),
         ),
         Method(
             "controllerpose",
             "ControllerPose: controller-camera keypoints + VR lifted by a network, IK (§4.3)",
             controllerpose,
+            sensors=("fisheye",),
             missing=model_missing,
         ),
     )

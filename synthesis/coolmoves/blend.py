@@ -5,13 +5,20 @@
 - "The left and right arm's motion will be governed by their respective hand's motion":
   joints of the left limb take the left-hand weights only, the right limb the right-hand ones,
   "for all the other joints ... a weighted average between the left and right arm weights".
-  We weight that average by each hand's match confidence (below), so that a hand without
-  good matches (or untracked) leaves the trunk and legs to the other.
-- "We also average out the weights of all the joints to compute a global match weight": the
-  paper does not say how a joint's weight becomes one number in [0, 1]. Ours: a hand's
-  confidence is the weighted mean of ``1 - d_i / max_distance`` over its matches (1 for an
-  exact match, 0 at the KD-tree threshold); a limb joint has its hand's confidence, every
-  other joint the mean of both, and the global match weight is the mean over all joints.
+  We weight that average by each hand's match confidence (below).
+- "We also average out the weights of all the joints to compute a global match weight",
+  which weighs the EWMA (§3.1.4; the abstract calls it the "joint prediction probability").
+  The paper does not say how a joint's weight becomes one number in [0, 1]; it approximates
+  "the likelihood of a motion being applied ... by a function of matching distance"
+  (§3.1.3). Ours: a match's likelihood is ``t / (t + d)`` for the KD-tree threshold ``t``
+  (1 for an exact match, 1/2 at the threshold, never 0: a heavy-tailed kernel whose
+  half-width is the threshold); a hand's confidence is the weighted mean over its matches; a
+  limb joint has its hand's confidence, every other joint the mean of both; the global match
+  weight is the mean over all joints. Before, the likelihood was ``1 - d / t`` floored at 0,
+  so an input farther than the threshold from every database window (2 cm tracking jitter,
+  real mocap against a generated database) got weight 0 and the output froze in its pose.
+- The trunk and legs weigh the two hands' matches by the hands' confidences, so that a hand
+  with poor matches (or untracked) leaves them to the other.
 
 Shapes: ``B`` queries, ``k`` matches per hand, ``M = 2k`` (left matches first), ``J`` joints.
 """
@@ -34,10 +41,15 @@ def inverse_distance_weights(dist: np.ndarray) -> np.ndarray:
     return np.divide(inv, total, out=np.zeros_like(inv), where=total > 0)
 
 
+def match_likelihood(dist: np.ndarray, max_distance: float) -> np.ndarray:
+    """``t / (t + d)`` of distances ``d`` for the threshold ``t``: 1 at 0, 1/2 at ``t``, 0
+    only for missing (``inf``) matches."""
+    return max_distance / (max_distance + np.asarray(dist, float))
+
+
 def hand_confidence(dist: np.ndarray, weights: np.ndarray, max_distance: float) -> np.ndarray:
-    """``(B,)`` weighted mean of ``1 - d / max_distance`` over one hand's matches."""
-    closeness = np.clip(1.0 - np.nan_to_num(dist, posinf=max_distance) / max_distance, 0.0, 1.0)
-    return np.sum(weights * closeness, axis=-1)
+    """``(B,)`` weighted mean of :func:`match_likelihood` over one hand's matches."""
+    return np.sum(weights * match_likelihood(dist, max_distance), axis=-1)
 
 
 def group_weights(
@@ -63,9 +75,8 @@ def group_weights(
     qr = hand_confidence(dist_right, wr, max_distance)
     zl, zr = np.zeros_like(wl), np.zeros_like(wr)
     has_l, has_r = wl.sum(-1) > 0, wr.sum(-1) > 0
-    # Trunk and legs: both hands, by confidence; equal shares when both are at the threshold.
-    share_l = np.where(ql + qr > 0, ql / np.maximum(ql + qr, 1e-300), 0.5)
-    share_l = np.where(has_l & has_r, share_l, has_l.astype(float))
+    # Trunk and legs: both hands, by confidence (positive wherever a hand has a match).
+    share_l = np.where(has_l & has_r, ql / np.maximum(ql + qr, 1e-300), has_l.astype(float))
     rest = np.concatenate([share_l[:, None] * wl, (1.0 - share_l)[:, None] * wr], axis=-1)
     weights = np.stack([np.concatenate([wl, zr], -1), np.concatenate([zl, wr], -1), rest], axis=1)
     count = has_l.astype(float) + has_r

@@ -4,9 +4,18 @@
 neighborhood distance threshold, using the L2 norm as our distance metric", separately for
 the left and the right hand. The paper's Fig. 3 shows the top 5 matches per hand, hence
 ``K_NEIGHBOURS = 5``. The paper gives no value for the threshold; ours is in the units of
-:mod:`.features` (metres over one window). The accuracy protocols choose it per fold on a
-validation split of the fold's training data (:mod:`synthesis.evaluate.validation`);
-:data:`MAX_DISTANCE` is the default elsewhere (scenarios, benchmarks, a plain ``CoolMoves``).
+:mod:`.features` (metres over one window).
+
+The threshold narrows the k nearest to those within it; it never leaves a hand without
+matches: when even the nearest window lies beyond it (an input unlike every database window,
+e.g. tracking with centimetres of jitter, whose accelerations no clean recording has), the k
+nearest are blended all the same, as the paper's pipeline always produces a pose (§3.1.4).
+Dropping every match there froze the output in its last pose (hand correlation exactly 0
+on 2 cm jitter, a real CMU run and a Bandai wave against generated databases).
+
+The accuracy protocols choose the threshold per fold on a validation split of the fold's
+training data (:mod:`synthesis.evaluate.validation`); :data:`MAX_DISTANCE` is the default
+elsewhere (scenarios, benchmarks, a plain ``CoolMoves``).
 """
 
 from __future__ import annotations
@@ -25,6 +34,20 @@ MAX_DISTANCE = 0.6
 on the built-in generator's cross-subject evaluation, i.e. seeing the test folds; the
 protocols no longer use it as such (:func:`synthesis.evaluate.validation.choose_max_distance`
 picks from a grid around it on training data only)."""
+
+
+SIDE_SEPARATION = 1e6
+"""Extra coordinate of the right hand's windows in :class:`BothHandsKNN` (the left's is 0):
+far beyond any distance between two windows of one side (metres over one window)."""
+
+
+def within_threshold(dist: np.ndarray, idx: np.ndarray, max_distance: float):
+    """The k nearest ``dist, idx (..., k)`` (nearest first) narrowed to those within
+    ``max_distance``, or all k where even the nearest is beyond it; the dropped ones get
+    distance ``inf`` and index -1. Returns ``(dist, idx, inverse-distance weights)``."""
+    keep = (dist <= max_distance) | (dist[..., :1] > max_distance)
+    dist = np.where(keep, dist, np.inf)  # untracked sides come as inf and stay so
+    return dist, np.where(np.isfinite(dist), idx, -1), inverse_distance_weights(dist)
 
 
 class KNNMatcher:
@@ -47,24 +70,21 @@ class KNNMatcher:
         """Distances, indices and blend weights ``(B, k)`` for ``queries (B, F)``, nearest
         first; weights are inversely proportional to distance (§3.1.4).
 
-        Matches beyond the threshold have distance ``inf``, index ``-1`` and weight 0.
+        Matches dropped by the threshold (:func:`within_threshold`) have distance ``inf``,
+        index ``-1`` and weight 0.
         """
-        dist, idx = self.tree.query(
-            queries, k=self.k, distance_upper_bound=self.max_distance, workers=1
-        )
-        dist = np.asarray(dist, float).reshape(len(queries), self.k)
-        idx = np.asarray(idx).reshape(len(queries), self.k)
-        return dist, np.where(np.isfinite(dist), idx, -1), inverse_distance_weights(dist)
+        dist, idx = self.tree.query(queries, k=list(range(1, self.k + 1)), workers=1)
+        return within_threshold(dist, idx, self.max_distance)
 
 
 class BothHandsKNN:
     """Both hands' :class:`KNNMatcher` searches in one KD-tree, so that one sample costs one
     query call (the per-call set-up of ``cKDTree.query`` is most of a single query's time).
 
-    The sides' vectors get one extra coordinate, 0 for the left hand and ``separation`` for
-    the right, larger than the distance threshold: a query carrying its side's coordinate
-    never finds the other side's windows within the threshold, and its distances to its own
-    side are those of the side's own tree (the extra term is exactly 0).
+    The sides' vectors get one extra coordinate, 0 for the left hand and
+    :data:`SIDE_SEPARATION` for the right: a query carrying its side's coordinate finds its
+    k nearest on its own side, at the distances of the side's own tree (the extra term is
+    exactly 0).
 
     Args:
         vectors: per side (left, right) ``(N_s, F)`` search vectors of the database windows.
@@ -78,7 +98,7 @@ class BothHandsKNN:
     ):
         self.k = int(min(k, *(len(v) for v in vectors)))
         self.max_distance = float(max_distance)
-        self._side_coord = np.array([0.0, 2.0 * self.max_distance + 1.0])
+        self._side_coord = np.array([0.0, SIDE_SEPARATION])
         self._first = np.cumsum([0] + [len(v) for v in vectors[:-1]])  # (2,) index offsets
         points = np.concatenate(
             [
@@ -98,16 +118,11 @@ class BothHandsKNN:
         points[..., :-1] = np.where(tracked[..., None], queries, 0.0)  # NaN-free
         points[..., -1] = self._side_coord
         dist, idx = self.tree.query(
-            points.reshape(2 * b, -1),
-            k=self.k,
-            distance_upper_bound=self.max_distance,
-            workers=1,
+            points.reshape(2 * b, -1), k=list(range(1, self.k + 1)), workers=1
         )
         dist = np.where(tracked.reshape(2 * b, 1), dist, np.inf).reshape(b, 2, self.k)
-        idx = np.asarray(idx).reshape(b, 2, self.k) - self._first[:, None]
-        dist = dist.transpose(1, 0, 2)
-        idx = np.where(np.isfinite(dist), idx.transpose(1, 0, 2), -1)
-        return dist, idx, inverse_distance_weights(dist)
+        idx = idx.reshape(b, 2, self.k) - self._first[:, None]
+        return within_threshold(dist.transpose(1, 0, 2), idx.transpose(1, 0, 2), self.max_distance)
 
 
 class PerHand:

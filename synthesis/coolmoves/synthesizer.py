@@ -11,7 +11,8 @@ Order of the last steps: the paper scales and translates before thresholding; we
 first, so that the headset point of the final pose is exactly the tracked one.
 
 Invalid input: a hand is matched only when its whole window (and the headset) was tracked;
-a side without matches holds its limb (EWMA weight 0), with no match at all the whole pose
+a tracked side always has matches (:mod:`.knn`); an untracked side has none and holds its
+limb (EWMA weight 0), with neither side tracked the whole pose
 holds, and the translation holds the last tracked headset position. Late or repeated
 timestamps are ignored by ``step``; ``run`` repairs and re-clocks the stream first.
 

@@ -121,11 +121,25 @@ def test_query_identical_to_database_window_returns_it(small_db):
         assert np.all(np.diff(dist[0][np.isfinite(dist[0])]) >= 0)
 
 
-def test_knn_threshold_drops_far_matches(small_db):
-    matcher = KNNMatcher(small_db.search[0], k=5, max_distance=1e-6)
-    far = small_db.windows[[0], :, 0] + 1.0
-    dist, idx, _ = matcher.query(search_vectors(far))
-    assert np.all(np.isinf(dist)) and np.all(idx == -1)
+def test_knn_threshold_drops_far_matches_but_never_all(small_db):
+    """Within the threshold only the near matches count; an input beyond it from every
+    window still gets its k nearest (the output must not freeze)."""
+    exact = search_vectors(small_db.windows[[0], :, 0])
+    tree = KNNMatcher(small_db.search[0], k=5, max_distance=1e9)
+    second = tree.query(exact)[0][0, 1]
+    near = KNNMatcher(small_db.search[0], k=5, max_distance=second / 2)
+    dist, idx, w = near.query(exact)
+    assert dist[0, 0] == 0.0 and np.all(np.isinf(dist[0, 1:])) and np.all(idx[0, 1:] == -1)
+    assert w[0, 0] == pytest.approx(1.0)
+    far = search_vectors(small_db.windows[[0], :, 0] + 1.0)
+    dist, idx, w = KNNMatcher(small_db.search[0], k=5, max_distance=1e-6).query(far)
+    assert np.all(np.isfinite(dist)) and np.all(idx >= 0)
+    assert w.sum() == pytest.approx(1.0) and np.all(np.diff(dist[0]) >= 0)
+
+
+def test_knn_k_of_one(small_db):
+    dist, idx, w = KNNMatcher(small_db.search[0], k=1).query(small_db.search[0][:3])
+    assert dist.shape == idx.shape == w.shape == (3, 1) and np.all(w == 1.0)
 
 
 @pytest.mark.parametrize("theta", [0.3, -1.2, 2.9, np.pi / 2])
@@ -191,8 +205,9 @@ def test_group_weights_route_hands_to_their_arms():
     weights, conf = group_weights(dl, dr, max_distance=0.5)
     np.testing.assert_allclose(weights[0, 0], [2 / 3, 1 / 3, 0, 0], atol=1e-8)
     np.testing.assert_allclose(weights[0, 1], [0, 0, 1, 0], atol=1e-8)
-    ql = 2 / 3 * 0.8 + 1 / 3 * 0.6
-    qr = 0.4
+    # Each match's likelihood t / (t + d): 0.5/0.6 and 0.5/0.7 on the left, 0.5/0.8 right.
+    ql = 2 / 3 * 5 / 6 + 1 / 3 * 5 / 7
+    qr = 5 / 8
     np.testing.assert_allclose(conf[0], [ql, qr, (ql + qr) / 2])
     share = ql / (ql + qr)
     np.testing.assert_allclose(weights[0, 2], [share * 2 / 3, share / 3, 1 - share, 0], atol=1e-8)

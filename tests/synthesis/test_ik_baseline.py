@@ -101,7 +101,7 @@ def test_stepper_steps_once_the_stance_moves_away():
     stepper = Stepper(feet.copy())
     assert np.allclose(stepper.advance(feet, np.zeros(3), 1 / 90), feet)  # standing still
     moved = feet + np.array([0.3, 0.0, 0.0])
-    for _ in range(60):  # 0.67 s: time for both feet to step (at most 0.2 s each)
+    for _ in range(60):  # 0.67 s: time for both feet to step (at most 0.22 s each)
         out = stepper.advance(moved, np.zeros(3), 1 / 90)
     assert np.allclose(out, moved)
 
