@@ -65,12 +65,13 @@ PHYSICS = (
 """The physics checks of each output in the table (:data:`sim.plausibility.CONTRACT_KEYS`)."""
 
 
-def fisheye_keypoints(motion: Motion) -> KeypointRecording:
-    """The controller cameras' keypoints of a test motion (ControllerPose's input)."""
+def fisheye_keypoints(motion: Motion, seed: int) -> KeypointRecording:
+    """The controller cameras' keypoints of a test motion (ControllerPose's input), the
+    detector's errors seeded like the trial's VR stream."""
     from scripts.controllerpose.recording import keypoint_recording
     from sim.humanoid import humanoid_for
 
-    return keypoint_recording(humanoid_for(motion))
+    return keypoint_recording(humanoid_for(motion), seed)
 
 
 def trial_row(result) -> dict[str, float]:
@@ -106,7 +107,9 @@ def fold_rows(fold, setup: VRSetup, methods: Sequence[str], checks: CheckConfig,
             dict(overrides),
             walk_in=walk_in(setup, trial.motion.skeleton, trial.seed) if trackers else None,
             kinect=kinect,
-            fisheye=fisheye_keypoints(trial.motion) if "controllerpose" in methods else None,
+            fisheye=fisheye_keypoints(trial.motion, trial.seed)
+            if "controllerpose" in methods
+            else None,
         )
         for name in methods:
             result = score_method(build(name, inputs), trial.motion, stream, checks, True)
