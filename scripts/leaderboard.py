@@ -68,7 +68,8 @@ PHYSICS = (
 
 
 def fisheye_keypoints(motion: Motion, seed: int) -> KeypointRecording:
-    """The controller cameras' keypoints of a test motion (ControllerPose's input)."""
+    """The controller cameras' keypoints of a test motion (ControllerPose's input), the
+    detector's errors seeded like the trial's VR stream."""
     from scripts.controllerpose.recording import keypoint_recording
     from sim.humanoid import humanoid_for
 

@@ -23,6 +23,7 @@ from scripts.scenario import Scenario, ScenarioError
 from scripts.stages import STAGES, physics
 from scripts.suite.identity import scenario_hash
 from sim.thresholds import ConfigError
+from synthesis.methods import METHODS
 
 METRICS: dict[str, str] = {k: v for stage in STAGES for k, v in stage.METRICS.items()}
 
@@ -34,6 +35,12 @@ def produced_metrics(stage, scenario: Scenario) -> set[str]:
 
 def validate(scenario: Scenario) -> None:
     """Everything about a scenario that can be checked before running it."""
+    methods = scenario.synthesis.methods if scenario.synthesis is not None else ()
+    unknown_methods = [m for m in methods if m not in METHODS]
+    if unknown_methods:  # before the motion, body and physics stages, not after them
+        raise ScenarioError(
+            f"unknown synthesis method(s) {unknown_methods}; known: {', '.join(METHODS)}"
+        )
     physics_keys = set(physics.METRICS)
     misplaced = sorted(set(scenario.thresholds) & physics_keys)
     if misplaced:

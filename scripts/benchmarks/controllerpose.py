@@ -49,8 +49,8 @@ def run(quick: bool = False) -> list[BenchRow]:
     motion = generate("walk", duration_s=1.0 if quick else 3.0, fps=30.0, seed=0)
     humanoid = humanoid_for(motion)
     height = float(motion.meta["subject"]["height_m"])
-    keypoints_s = best_of(lambda: keypoint_recording(humanoid), 2)
-    recording = keypoint_recording(humanoid)
+    keypoints_s = best_of(lambda: keypoint_recording(humanoid, 0), 2)
+    recording = keypoint_recording(humanoid, 0)
     frames = len(recording.time)
     stream = on_clock(VRSetup(devices=HEADSET_AND_CONTROLLERS).sample(humanoid.motion, seed=0))
     vr = VRStream(

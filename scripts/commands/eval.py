@@ -309,6 +309,9 @@ def register(app: typer.Typer) -> None:
         ):
             if not lo <= value <= hi:  # also NaN
                 raise EvaluationError(f"{option} must be {lo:g}-{hi:g}, got {value}")
+        # Every method, MoveBox too: a typo is not silently run as the default.
+        if protocol not in PROTOCOLS:
+            raise EvaluationError(f"unknown protocol {protocol!r}; use {' or '.join(PROTOCOLS)}")
         check_outputs(json_out=json_out, out=out)
         if method == "movebox":
             keep = None if classes is None else [c.strip() for c in classes.split(",") if c.strip()]
@@ -321,8 +324,6 @@ def register(app: typer.Typer) -> None:
                 f"unknown method {method!r}; available: {', '.join(EVALUABLE)}, leaderboard, "
                 "avatargo, movebox"
             )
-        if protocol not in PROTOCOLS:
-            raise EvaluationError(f"unknown protocol {protocol!r}; use {' or '.join(PROTOCOLS)}")
         wanted = None if classes is None else [c.strip() for c in classes.split(",") if c.strip()]
         if method == "avatargo" and wanted is None and library == "builtin":
             wanted = list(BUILTIN_ACTIVITIES[:1] if quick else BUILTIN_ACTIVITIES)

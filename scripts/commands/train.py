@@ -71,7 +71,7 @@ def register(app: typer.Typer) -> None:
         ):
             if value < 1:
                 raise AvatarsimError(f"{name} must be at least 1, got {value}")
-        check_outputs(json_out=json_out)
+        check_outputs(json_out=json_out, out=out)
         net = NetConfig(width=width, blocks=blocks, use_vr=vr)
         config = TrainConfig(
             max_epochs=max_epochs,

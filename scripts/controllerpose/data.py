@@ -117,7 +117,7 @@ def mocap_examples(folder: Path, clips: int, seconds: float, seed: int = 0) -> E
     for group, path in enumerate(picked):
         motion = read_bvh(path)
         humanoid = humanoid_for(motion[: int(seconds * motion.fps)])
-        recording = keypoint_recording(humanoid)
+        recording = keypoint_recording(humanoid, seed + group)
         truth = humanoid.motion.sample(recording.time)
         stream = setup.sample(humanoid.motion, seed=seed + group)
         vr = VRStream(

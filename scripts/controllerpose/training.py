@@ -34,9 +34,12 @@ def resumable(out: Path, net: NetConfig, config: TrainConfig, sha: str):
     """The checkpoint in ``out`` to resume, or None for a fresh run.
 
     Raises:
-        CheckpointError: ``out`` holds a run of another dataset or config.
+        CheckpointError: ``out`` holds a run of another dataset or config, or files but no
+            run (training would write among, and over, someone else's files).
     """
     if not (out / FILE).is_file():
+        if out.is_dir() and any(out.iterdir()):
+            raise CheckpointError(f"{out} is not empty and holds no run; choose an empty --out")
         return None
     previous = load(out)
     if previous.manifest_sha256 != sha or same_run(previous.train) != same_run(config.as_dict()):

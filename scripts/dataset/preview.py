@@ -79,6 +79,13 @@ def _draw_skeleton(ax: Any, points: np.ndarray, shown: np.ndarray) -> None:
     ax.scatter(*points[~shown].T, s=12, facecolors="none", edgecolors="k", zorder=3)
 
 
+def skeleton_pixels(sample: dict) -> np.ndarray:
+    """``(Tc, C, 17, 2)`` the pixels the sheet draws: the exact projections
+    (``fisheye_uv_projected``, the ground truth), not the detector's keypoints, which sit at
+    (0, 0) where a joint was missed and would pull lines to the image corner."""
+    return sample.get("fisheye_uv_projected", sample["fisheye_uv"])
+
+
 def _image_entry(meta: dict, camera: str, n: int) -> str | None:
     """The entry name of camera ``camera``'s ``n``-th rendered image, if images were made."""
     images = meta["channels"].get("fisheye_images")
@@ -107,7 +114,7 @@ def _panel(ax: Any, key: str, sample: dict, rng: np.random.Generator) -> dict[st
             ax.imshow(image, extent=(0, model["width"], model["height"], 0))
         frame_box = Rectangle((0, 0), model["width"], model["height"], fill=False, ls="--")
         ax.add_patch(frame_box)
-        _draw_skeleton(ax, sample["fisheye_uv"][frame, camera], seen[camera])
+        _draw_skeleton(ax, skeleton_pixels(sample)[frame, camera], seen[camera])
         ax.set_xlim(-0.25 * model["width"], 1.25 * model["width"])
         ax.set_ylim(1.25 * model["height"], -0.25 * model["height"])  # image rows go down
         ax.set_title(f"{title}\n{name} frame {frame}", fontsize=7)

@@ -83,5 +83,5 @@ def run(ctx: RunContext) -> None:
     if ctx.scenario.devices.fisheye:
         from scripts.controllerpose.recording import keypoint_recording
 
-        ctx.fisheye_keypoints = keypoint_recording(ctx.humanoid)
+        ctx.fisheye_keypoints = keypoint_recording(ctx.humanoid, ctx.scenario.seed)
         ctx.info["devices"]["fisheye_frames"] = int(ctx.fisheye_keypoints.time.size)

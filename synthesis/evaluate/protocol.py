@@ -22,7 +22,7 @@ from avatar_models import Motion, Skeleton
 from avatar_models.measure import standing_height
 from avatar_models.rigs import load_rig
 from render_cams import VRSetup
-from render_cams.vr import Attachment
+from render_cams.vr import HEADSET_AND_CONTROLLERS, Attachment
 from synthesis.base import SynthesisError
 from synthesis.coolmoves import CoolMoves, Database
 from synthesis.evaluate.folds import Fold, database_for, folds
@@ -63,8 +63,12 @@ def ik_rig_for(
     turned into the avatar's upright joint frames (:func:`attachments_on_upright_rig`)."""
     if stands_upright(rig):
         return rig, None
-    measured = setup.attachments(truth, np.random.default_rng(0))
-    return load_rig("avatar").skeleton, attachments_on_upright_rig(measured, truth.skeleton)
+    attachments = setup.attachments(truth, np.random.default_rng(0))
+    measured = dict(zip(setup.devices, attachments, strict=True))
+    # The baseline steers the headset and controllers only: a setup with trackers (AvatarGo's,
+    # in the leaderboard) has more attachments than it reads.
+    steered = [measured[device] for device in HEADSET_AND_CONTROLLERS]
+    return load_rig("avatar").skeleton, attachments_on_upright_rig(steered, truth.skeleton)
 
 
 def ik_baseline_for(database: Database, truth: Motion, setup: VRSetup) -> IKBaseline:

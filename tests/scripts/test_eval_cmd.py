@@ -38,6 +38,7 @@ def test_eval_builtin_writes_contract_json_and_plots(tmp_path):
     [
         (["eval", "magic"], "unknown method"),
         (["eval", "coolmoves", "--protocol", "cross-galaxy"], "unknown protocol"),
+        (["eval", "movebox", "--protocol", "nonsense"], "unknown protocol"),
         (["eval", "coolmoves", "--library", "/no/such/folder"], "not"),
     ],
 )

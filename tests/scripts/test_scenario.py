@@ -93,3 +93,13 @@ def test_control_thresholds_need_the_control_stage():
     with pytest.raises(ScenarioError, match="does not produce"):
         validate(parse_scenario({"thresholds": {"control_fell": 0.0}}))
     validate(parse_scenario({"control": {}, "thresholds": {"control_fell": 0.0}}))
+
+
+def test_an_unknown_method_is_rejected_before_the_run():
+    # Regression: a typo in [synthesis] methods surfaced only after the motion, body, physics
+    # and device stages had run.
+    from scripts.pipeline import validate
+
+    with pytest.raises(ScenarioError, match="unknown synthesis method.*nonsense"):
+        validate(parse_scenario({"devices": {}, "synthesis": {"methods": ["ik", "nonsense"]}}))
+    validate(parse_scenario({"devices": {}, "synthesis": {"methods": ["ik"]}}))

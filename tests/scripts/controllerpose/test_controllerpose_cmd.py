@@ -89,3 +89,16 @@ def test_nan_in_the_features_exits_2(cp_dataset, tmp_path, monkeypatch):
     )
     assert result.exit_code == 2 and "non-finite" in result.output
     assert not (tmp_path / "r" / "checkpoint.pt").exists()
+
+
+def test_an_occupied_out_that_holds_no_run_exits_2(cp_dataset, tmp_path):
+    # Regression: training wrote its checkpoint among unrelated files.
+    occupied = tmp_path / "occupied"
+    occupied.mkdir()
+    (occupied / "notes.txt").write_text("mine")
+    args = ["train", "controllerpose", "--data", str(cp_dataset), "--max-epochs", "1"]
+    result = runner.invoke(app, [*args, "--out", str(occupied)])
+    assert result.exit_code == 2 and "not empty" in result.output
+    assert sorted(p.name for p in occupied.iterdir()) == ["notes.txt"]
+    result = runner.invoke(app, [*args, "--out", str(occupied / "notes.txt")])
+    assert result.exit_code == 2 and "is a file" in result.output

@@ -40,7 +40,7 @@ def test_controllerpose_runs_on_a_real_clip(source, mocap_dir, cp_run, monkeypat
         database_factory=list,
         user_height_m=standing_height(humanoid.motion),
         rig=humanoid.body.skeleton,
-        fisheye=keypoint_recording(humanoid),
+        fisheye=keypoint_recording(humanoid, 0),
     )
     output = build("controllerpose", inputs).run(stream)
     assert output.n_frames == on_clock(stream).n_samples

@@ -9,8 +9,9 @@ from typer.testing import CliRunner
 from scripts.cli import app
 from scripts.dataset.config import load_config
 from scripts.dataset.manifest import read_manifest
-from scripts.dataset.preview import SKELETON_LINES, preview_sheet
+from scripts.dataset.preview import SKELETON_LINES, preview_sheet, skeleton_pixels
 from scripts.dataset.runner import generate
+from scripts.dataset.shards import read_samples
 from tests.scripts.dataset.builders import write_config
 
 runner = CliRunner()
@@ -60,3 +61,18 @@ def test_preview_draws_the_rendered_image_under_the_skeleton(tmp_path):
     # The images fill their frames: 34 % of the sheet is not white here, 7 % of a
     # keypoints-only sheet of 8 panels (frame boxes, skeletons and titles).
     assert (image < 250).mean() > 0.2
+
+
+def test_preview_draws_the_exact_projections_not_missed_detections(tiny_dataset):
+    # Regression: missed detections sit at (0, 0) in fisheye_uv; drawn, every panel had lines
+    # from its image corner. The sheet draws the ground truth's projections instead.
+    shard = sorted(tiny_dataset.rglob("*.tar"))[0]
+    samples = [sample for _, sample in read_samples(shard)]
+    missed = [s for s in samples if (s["fisheye_in_view"] & ~s["fisheye_detected"]).any()]
+    assert missed, "the detector misses some in-view joints of the tiny dataset"
+    for sample in missed:
+        drawn = skeleton_pixels(sample)[sample["fisheye_in_view"]]
+        assert np.all(np.abs(drawn).sum(-1) > 0)  # no in-view joint at the corner
+        np.testing.assert_array_equal(
+            drawn, sample["fisheye_uv_projected"][sample["fisheye_in_view"]]
+        )

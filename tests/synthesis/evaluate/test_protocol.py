@@ -67,3 +67,18 @@ def test_alignment_and_turned_copies_help_a_user_facing_away():
     assert plain["alignment_no_smoothing"] < 0.5 * plain["no_alignment_no_smoothing"]
     assert copies["no_alignment_no_smoothing"] < 0.5 * plain["no_alignment_no_smoothing"]
     assert copies["alignment_no_smoothing"] < copies["no_alignment_no_smoothing"] - 1.0
+
+
+def test_the_ik_rig_of_a_bandai_take_with_trackers_is_calibrated_on_three_devices():
+    # Regression: the leaderboard's setup carries AvatarGo's trackers; on a Bandai take (rest
+    # pose not upright) the IK baseline got all six attachments and every fold failed.
+    from avatar_models import Motion
+    from avatar_models.rigs import load_rig
+    from render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
+    from synthesis.evaluate.protocol import ik_rig_for
+
+    skeleton = load_rig("bandai").skeleton
+    still = np.tile([1.0, 0.0, 0.0, 0.0], (2, skeleton.n_joints, 1))
+    truth = Motion(skeleton, 30.0, np.zeros((2, 3)), still)
+    rig, calibration = ik_rig_for(skeleton, truth, VRSetup(devices=FULL_BODY))
+    assert rig is not skeleton and len(calibration) == len(HEADSET_AND_CONTROLLERS) == 3
