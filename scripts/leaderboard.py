@@ -114,14 +114,15 @@ def trial_row(result) -> dict[str, float]:
 
 
 def fold_rows(fold, setup: VRSetup, methods: Sequence[str], checks: CheckConfig, tune: bool):
-    """``[(class, method, row)]`` for every test trial of ``fold`` and every method."""
+    """``[(class, method, row)]`` for every test trial of ``fold`` and every method, and
+    ``[{"method", "class", "reason"}]`` for each method that failed on a trial."""
     coolmoves = METHODS["coolmoves"].options
     overrides = {}
     if tune:
         overrides["max_distance"] = choose_max_distance(fold.train, fold.protocol, coolmoves, setup)
     database = cache(lambda: database_for(fold.train))
     sensors = sensors_of(methods)
-    out = []
+    out, failures = [], []
     trackers = set(FULL_BODY) <= set(setup.devices)
     for trial in fold.test:
         stream = setup.sample(trial.motion, seed=trial.seed)
@@ -137,9 +138,13 @@ def fold_rows(fold, setup: VRSetup, methods: Sequence[str], checks: CheckConfig,
             **recordings,
         )
         for name in methods:
-            result = score_method(build(name, inputs), trial.motion, stream, checks, True)
+            try:  # one method's failure on a trial leaves the others' rows
+                result = score_method(build(name, inputs), trial.motion, stream, checks, True)
+            except SynthesisError as exc:
+                failures.append({"method": name, "class": trial.cls, "reason": str(exc)})
+                continue
             out.append((trial.cls, name, trial_row(result)))
-    return out
+    return out, failures
 
 
 def _mean_rows(rows: list[dict]) -> dict[str, float]:
@@ -160,7 +165,8 @@ def run_leaderboard(
     ``protocol``.
 
     Returns ``{"protocol", "methods": {name: {column: value}}, "per_class": {class: {name:
-    {column: value}}}, "trials", "failed_folds", "skipped"}``.
+    {column: value}}}, "trials", "failed_folds", "failed_methods", "skipped"}``; a method
+    that fails on a trial (``failed_methods``) leaves the other methods' rows of it.
     """
     methods = list(methods or ready_methods())
     sensors_of(methods)  # every sensor can be recorded, checked before any work
@@ -169,28 +175,37 @@ def run_leaderboard(
         raise EvaluationError(f"no class can be evaluated {protocol}: {skipped}")
     # Every device, Vive trackers included (AvatarGo's); the others read only theirs.
     setup, checks = setup or VRSetup(devices=FULL_BODY), checks or CheckConfig()
-    rows, failed = [], []
+    rows, failed, method_failures, n_trials = [], [], [], 0
     for i, fold in enumerate(all_folds):
         try:
-            rows.extend(fold_rows(fold, setup, methods, checks, tune))
+            fold_out, fold_failures = fold_rows(fold, setup, methods, checks, tune)
         except SynthesisError as exc:  # e.g. no training clip passes the correlation filter
             failed.append({"class": fold.cls, "held_out": fold.held_out, "reason": str(exc)})
+        else:
+            rows.extend(fold_out)
+            method_failures.extend(fold_failures)
+            n_trials += len(fold.test)
         if progress is not None:
             progress(i + 1, len(all_folds), f"{fold.cls} / {fold.held_out}")
     if not rows:
         raise EvaluationError(f"every fold failed: {failed[:3]}")
     classes = sorted({c for c, _, _ in rows})
-    per_class = {
-        c: {m: _mean_rows([r for cc, mm, r in rows if cc == c and mm == m]) for m in methods}
-        for c in classes
+    per_class = {c: {} for c in classes}
+    for c, m in dict.fromkeys((c, m) for c, m, _ in rows):
+        per_class[c][m] = _mean_rows([r for cc, mm, r in rows if cc == c and mm == m])
+    # A method is averaged over the classes it ran on (its failures are listed beside).
+    overall = {
+        m: _mean_rows([per_class[c][m] for c in classes if m in per_class[c]])
+        for m in methods
+        if any(m in per_class[c] for c in classes)
     }
-    overall = {m: _mean_rows([per_class[c][m] for c in classes]) for m in methods}
     return {
         "protocol": protocol,
         "methods": overall,
         "per_class": per_class,
-        "trials": len(rows) // len(methods),
+        "trials": n_trials,
         "failed_folds": failed,
+        "failed_methods": method_failures,
         "skipped": skipped,
         "columns": COLUMNS,
     }

@@ -76,6 +76,11 @@ def write_leaderboard(board: dict, out: Path, json_out: Path | None) -> None:
             "[yellow]fold failed[/] "
             + escape(f"{fail['class']}/{fail['held_out']}: {fail['reason']}")
         )
+    for fail in board.get("failed_methods", []):
+        console.print(
+            "[yellow]method failed[/] "
+            + escape(f"{fail['method']} on {fail['class']}: {fail['reason']}")
+        )
     out.mkdir(parents=True, exist_ok=True)
     plot = write_plot(board, out / "leaderboard.png")
     (out / "leaderboard.html").write_text(render_page(board, plot))

@@ -90,3 +90,20 @@ def test_a_sensor_without_recorder_is_refused_before_any_work(monkeypatch):
     monkeypatch.setattr(leaderboard, "RECORDERS", {})
     with pytest.raises(EvaluationError, match="kinect"):
         run_leaderboard([], "cross-trial", methods=["ik", "probe"])
+
+
+def test_a_method_failing_on_a_trial_leaves_the_others_rows(monkeypatch):
+    from scripts import leaderboard
+    from synthesis.base import SynthesisError
+    from synthesis.evaluate import builtin_trials
+    from synthesis.methods import Method
+
+    def refuse(inputs):
+        raise SynthesisError("probe cannot run here")
+
+    monkeypatch.setitem(leaderboard.METHODS, "probe", Method("probe", "always fails", refuse))
+    trials = builtin_trials(("box",), n_subjects=2, n_takes=1, duration_s=1.0, seed=0)
+    board = run_leaderboard(trials, "cross-subject", methods=["ik", "probe"], tune=False)
+    assert set(board["methods"]) == {"ik"} and board["trials"] == 2
+    assert [f["method"] for f in board["failed_methods"]] == ["probe", "probe"]
+    assert "cannot run here" in board["failed_methods"][0]["reason"]

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from types import SimpleNamespace
 
+import pytest
+
 from render_cams.vr.dropouts import Dropouts
 from render_cams.vr.noise import Latency, PositionJitter
 from scripts.scenario import DevicesSpec
@@ -34,3 +36,22 @@ def test_kinect_metric_only_with_a_kinect():
     assert metrics() == {"vr_valid_frac"}
     assert metrics(kinect="azure-kinect") == {"vr_valid_frac", "kinect_tracked_frac"}
     assert metrics(vr=False, kinect="kinect-v2") == {"kinect_tracked_frac"}
+
+
+@pytest.mark.mocap
+def test_avatargo_on_a_rig_without_a_t_pose_rest_exits_2_naming_the_way_out(tmp_path, mocap_dir):
+    """Bandai's BVH rest pose has the arms down: AvatarGo's walk-in is refused in the devices
+    stage, before any synthesis, with the command that does evaluate it there."""
+    from typer.testing import CliRunner
+
+    from scripts.cli import app
+
+    clip = mocap_dir / "bandai/dataset-2/data/dataset-2_wave-right-hand_normal_001.bvh"
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(
+        f'name = "b2"\n[motion]\nsource = "{clip}"\nduration_s = 1.0\n'
+        '[devices]\ntrackers = true\n[synthesis]\nmethods = ["avatargo", "ik"]\n'
+    )
+    result = CliRunner().invoke(app, ["run", str(scenario), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2, result.output
+    assert "eval avatargo" in result.output and "T-pose" in result.output
