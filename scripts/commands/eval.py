@@ -54,23 +54,37 @@ def _table(results: dict) -> Table:
     return table
 
 
-def _board_table(board: dict) -> Table:
-    from scripts.leaderboard import COLUMNS
+def _board_tables(board: dict) -> list[Table]:
+    """The leaderboard as three narrow tables (accuracy, physics, latency), so that method
+    names stay whole in an 80-column terminal."""
+    from scripts.leaderboard import COLUMNS, PHYSICS
 
-    table = Table(title=f"leaderboard {board['protocol']}, {board['trials']} test trials (cm)")
-    table.add_column("method")
-    for header in COLUMNS.values():
-        table.add_column(header, justify="right")
-    for name, s in board["methods"].items():
-        table.add_row(escape(name), *(f"{s[k]:.3g}" for k in COLUMNS))
-    return table
+    latency = ("step_ms_p50", "step_ms_p99")
+    groups = {
+        f"accuracy (cm), {board['protocol']}, {board['trials']} test trials": [
+            k for k in COLUMNS if k not in PHYSICS and k not in latency
+        ],
+        "physics of each output on the humanoid": list(PHYSICS),
+        "step latency": list(latency),
+    }
+    tables = []
+    for title, keys in groups.items():
+        table = Table(title=f"leaderboard: {title}")
+        table.add_column("method", no_wrap=True)
+        for key in keys:
+            table.add_column(COLUMNS[key], justify="right")
+        for name, s in board["methods"].items():
+            table.add_row(escape(name), *(f"{s[k]:.3g}" for k in keys))
+        tables.append(table)
+    return tables
 
 
 def write_leaderboard(board: dict, out: Path, json_out: Path | None) -> None:
     """Print the leaderboard; write its JSON, plot and page into ``out``."""
     from scripts.leaderboard import render_page, write_plot
 
-    console.print(_board_table(board))
+    for table in _board_tables(board):
+        console.print(table)
     for fail in board["failed_folds"]:
         console.print(
             "[yellow]fold failed[/] "
@@ -257,6 +271,10 @@ def register(app: typer.Typer) -> None:
             int, typer.Option(help="Database copies turned to this many yaws (beyond the paper).")
         ] = 1,
         quick: Annotated[bool, typer.Option(help="Small inputs, for a smoke run.")] = False,
+        methods: Annotated[
+            str | None,
+            typer.Option(help="leaderboard: comma-separated methods (default: every ready one)."),
+        ] = None,
         audio: Annotated[
             Path | None,
             typer.Option(help="movebox: a WAV file or folder for lip sync (the story's voice)."),
@@ -302,6 +320,7 @@ def register(app: typer.Typer) -> None:
             library_trials,
             run_protocol,
         )
+        from synthesis.methods import METHODS
         from synthesis.report_plots import write_plots
 
         for option, value, lo, hi in (
@@ -318,6 +337,14 @@ def register(app: typer.Typer) -> None:
         if protocol not in PROTOCOLS:
             raise EvaluationError(f"unknown protocol {protocol!r}; use {' or '.join(PROTOCOLS)}")
         check_outputs(json_out=json_out, out=out)
+        board_methods = None if methods is None else [m.strip() for m in methods.split(",")]
+        if board_methods is not None:
+            unknown = [m for m in board_methods if m not in METHODS]
+            if method != "leaderboard" or unknown or not board_methods:
+                raise EvaluationError(
+                    "--methods is for eval leaderboard, a comma-separated list of "
+                    f"{', '.join(METHODS)}; got {methods!r}"
+                )
         if method == "movebox":
             keep = None if classes is None else [c.strip() for c in classes.split(",") if c.strip()]
             run_movebox(
@@ -358,7 +385,7 @@ def register(app: typer.Typer) -> None:
                 write_avatargo(results, out, json_out)
                 return
             if method == "leaderboard":
-                board = run_leaderboard(trials, protocol, progress=progress)
+                board = run_leaderboard(trials, protocol, board_methods, progress=progress)
                 board.update(library=library, seed=seed, quick=quick, class_by=class_by)
                 write_leaderboard(board, out, json_out)
                 return

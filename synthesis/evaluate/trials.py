@@ -115,7 +115,7 @@ def library_trials(
         groups = {k: v for k, v in groups.items() if k in set(classes)}
     if not groups:
         raise EvaluationError(
-            f"no clip in {folder} has a {class_by} label{' in ' if classes else ''}"
+            f"no clip in {folder} has a label for {class_by}{' in ' if classes else ''}"
             f"{', '.join(classes) if classes else ''}"
         )
     rng = np.random.default_rng(seed)

@@ -40,6 +40,8 @@ def test_eval_builtin_writes_contract_json_and_plots(tmp_path):
         (["eval", "coolmoves", "--protocol", "cross-galaxy"], "unknown protocol"),
         (["eval", "movebox", "--protocol", "nonsense"], "unknown protocol"),
         (["eval", "coolmoves", "--library", "/no/such/folder"], "not"),
+        (["eval", "leaderboard", "--methods", "ik,magic"], "--methods"),
+        (["eval", "coolmoves", "--methods", "ik"], "--methods"),
     ],
 )
 def test_bad_input_exits_2_with_a_reason(args, reason):
