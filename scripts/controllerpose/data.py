@@ -2,7 +2,8 @@
 
 Reads the split through :class:`scripts.dataset.torch_dataset.ShardDataset` (in shard
 order) and turns each sample into :class:`~synthesis.controllerpose.examples.Examples`: the
-controller cameras' keypoints (``fisheye_uv``, ``fisheye_conf``) at their frame times, the
+four 2D poses of §4.3 (each controller's composite and torso-normal view as the detector
+reports them: ``fisheye_view_uv``, ``fisheye_view_conf``) at the camera frame times, the
 VR stream (``vr_*``), and the ground truth ``body17`` at the camera frames. The angle
 targets are computed from ``body17`` in the head's heading frame (the ``body17_angles``
 label channel is the same parameterisation in the world frame; datasets generated before
@@ -21,7 +22,15 @@ from scripts.dataset.manifest import MANIFEST_FILE, DatasetError, read_manifest
 from scripts.dataset.torch_dataset import ShardDataset
 from synthesis.controllerpose.examples import Examples, VRStream, concat, recording_examples
 
-NEEDED = ("body17", "fisheye_uv", "fisheye_conf", "vr_time", "vr_pos", "vr_quat", "vr_valid")
+NEEDED = (
+    "body17",
+    "fisheye_view_uv",
+    "fisheye_view_conf",
+    "vr_time",
+    "vr_pos",
+    "vr_quat",
+    "vr_valid",
+)
 
 
 def manifest_sha256(root: Path) -> str:
@@ -63,7 +72,7 @@ def load_examples(root: str | Path, split: str, frame_stride: int = 1) -> Exampl
         arrays = {k: sample[k].numpy() for k in NEEDED}
         meta = sample["json"]
         rate = float(meta["channels"]["fisheye"]["rate_hz"])
-        n_frames = arrays["fisheye_uv"].shape[0]
+        n_frames = arrays["fisheye_view_uv"].shape[0]
         frames = np.arange(0, n_frames, frame_stride)
         frame_time = frames / rate
         last = len(arrays["body17"]) - 1
@@ -79,8 +88,8 @@ def load_examples(root: str | Path, split: str, frame_stride: int = 1) -> Exampl
         parts.append(
             recording_examples(
                 body17,
-                arrays["fisheye_uv"][frames],
-                arrays["fisheye_conf"][frames],
+                arrays["fisheye_view_uv"][frames],
+                arrays["fisheye_view_conf"][frames],
                 frame_time,
                 vr,
                 sample_height(sample, body17),

@@ -6,11 +6,10 @@ features (:data:`PER_SKELETON`). A direction that touches an undetected joint (c
 0) is 0; the confidences say which ones those are.
 
 Up to four skeletons per frame (:data:`SKELETON_SLOTS`): the paper's left and right streams,
-each in its composite and its torso-normal view. The dataset format records the keypoints
-per controller camera (left ring, left grip, right ring, right grip; ``fisheye_uv``), not yet
-per composite/torso view, so until it does the four slots hold the four cameras' skeletons
-(the slot order is the recording's camera order). A slot whose view shows fewer than
-:data:`MIN_JOINTS` joints holds no skeleton: it is masked (``found`` False, its features 0);
+each in its composite and its torso-normal view, in that order (the dataset's
+``fisheye_view_uv``: left composite, left torso, right composite, right torso). A slot
+whose view shows fewer than :data:`MIN_JOINTS` joints holds no skeleton: it is masked
+(``found`` False, its features 0);
 a frame with no skeleton is dropped from training and held over by the synthesiser, as the
 paper's pipeline "awaits better frames".
 
@@ -44,11 +43,12 @@ VR_FEATURES = 15
 # joints at its edge is not a body detection).
 MIN_JOINTS = 6
 LAYOUT = {
-    "version": 1,
+    "version": 2,  # 1: the slots held the four cameras' skeletons
     "skeleton_slots": SKELETON_SLOTS,
     "per_skeleton": PER_SKELETON,
     "vr_features": VR_FEATURES,
     "skeleton": "136 unit 2D directions (pairs i<j of body17) + 17 confidences",
+    "slots": "left composite, left torso view, right composite, right torso view",
     "vr": "headset height; left, right controller: position (3) + quaternion wxyz (4) "
     "in the head's heading frame",
 }
