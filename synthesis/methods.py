@@ -141,19 +141,23 @@ def avatargo(name: str, summary: str, offsets: str) -> Method:
     return Method(name, summary, build)
 
 
-def movebox(inputs: MethodInputs) -> Synthesizer:
-    """MoveBox on the inputs' Kinect stream (:class:`~synthesis.movebox.MoveBox`), driving the
-    scored rig when it is an avatar rig, else the avatar rig resized to the user.
+def movebox(name: str, roll: str) -> Callable[[MethodInputs], Synthesizer]:
+    """A builder of MoveBox (:class:`~synthesis.movebox.MoveBox`) named ``name`` with
+    ``roll``, on the inputs' Kinect stream, driving the scored rig when it is an avatar rig,
+    else the avatar rig resized to the user; it raises :class:`SynthesisError` without a
+    Kinect stream (saying which ``[devices]`` entry to set)."""
 
-    Raises:
-        SynthesisError: no Kinect stream (the message says which ``[devices]`` entry to set).
-    """
-    if inputs.kinect is None:
-        raise SynthesisError(
-            'movebox reads the Kinect skeleton stream: set [devices] kinect = "kinect-v2" '
-            '(or "azure-kinect") in the scenario'
-        )
-    return MoveBox(inputs.kinect, avatar_for(inputs.rig, inputs.user_height_m))
+    def build(inputs: MethodInputs) -> Synthesizer:
+        if inputs.kinect is None:
+            raise SynthesisError(
+                'movebox reads the Kinect skeleton stream: set [devices] kinect = "kinect-v2" '
+                '(or "azure-kinect") in the scenario'
+            )
+        synth = MoveBox(inputs.kinect, avatar_for(inputs.rig, inputs.user_height_m), roll=roll)
+        synth.name = name
+        return synth
+
+    return build
 
 
 METHODS: dict[str, Method] = {
@@ -187,7 +191,13 @@ METHODS: dict[str, Method] = {
         Method(
             "movebox",
             "MoveBox: the Kinect skeleton retargeted onto the avatar (§III-A1; [devices] kinect)",
-            movebox,
+            movebox("movebox", "auto"),
+            sensors=("kinect",),
+        ),
+        Method(
+            "movebox+hinge-roll",
+            "MoveBox, limb roll turned onto the avatar's hinge axes (beyond the paper)",
+            movebox("movebox+hinge-roll", "hinge"),
             sensors=("kinect",),
         ),
         Method(

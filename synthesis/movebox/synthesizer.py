@@ -31,9 +31,10 @@ from synthesis.movebox.smoothing import (
     smoothing_alpha,
 )
 
-DEFAULT_ROLL = {"kinect_v2": "hinge", "azure_kinect": "sensor"}
-"""Roll per sensor: V2 has none of its own (§IV-B1): the avatar's rest roll with its hinge
-axes (:mod:`.retarget`); Azure's own is better (§IV-B1)."""
+DEFAULT_ROLL = {"kinect_v2": "rest", "azure_kinect": "sensor"}
+"""Roll per sensor, as the paper does it (§IV-B1): V2 has none of its own, so the avatar's
+rest roll; Azure's own. ``"hinge"`` (the rest roll turned onto the avatar's elbow and knee
+hinge axes, :mod:`.retarget`) goes beyond the paper and is asked for by name."""
 
 
 def check_stream(kinect: KinectSkeletonStream) -> None:
