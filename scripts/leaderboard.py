@@ -31,7 +31,7 @@ from scripts.method_score import score_method
 from scripts.movebox_eval import filmed
 from scripts.report_html import image_html, page, table_html
 from sim.thresholds import CheckConfig
-from synthesis.avatargo.study import walk_in
+from synthesis.avatargo.walk_in import walk_in
 from synthesis.base import SynthesisError
 from synthesis.controllerpose.synthesizer import KeypointRecording
 from synthesis.evaluate import (
@@ -134,7 +134,7 @@ def fold_rows(fold, setup: VRSetup, methods: Sequence[str], checks: CheckConfig,
             rig,
             calibration,
             dict(overrides),
-            walk_in=walk_in(setup, trial.motion.skeleton, trial.seed) if trackers else None,
+            walk_in=walk_in(setup, trial.motion, trial.seed) if trackers else None,
             **recordings,
         )
         for name in methods:

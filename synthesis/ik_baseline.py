@@ -123,22 +123,28 @@ def cadence(speed: float) -> float:
     return CADENCE_STEPS_PER_S[0] + CADENCE_STEPS_PER_S[1] * speed
 
 
-def rest_body_frame(skeleton: Skeleton) -> np.ndarray:
-    """``(3, 3)`` rotation whose columns are the forward, left and up axes of ``skeleton``'s
-    rest pose (up: pelvis to neck; left: right to left shoulder, made orthogonal to up).
-
-    Near the identity for a rig whose rest pose stands facing +X (the avatar rig, CMU, the
-    generator's); a rig stored lying or turned (Bandai's rest pose lies along +Y, as its
-    BVH's Y-up frame) gives the turn that stands it up.
-    """
-    rest = skeleton.rest_positions()[identify_rig(skeleton).body17_indices(skeleton)]
-    at = {name: rest[i] for i, name in enumerate(body17.BODY17)}
+def body_frame(positions: np.ndarray, skeleton: Skeleton) -> np.ndarray:
+    """``(3, 3)`` rotation whose columns are the forward, left and up axes of the body posed
+    at joint ``positions (J, 3)`` of ``skeleton`` (up: pelvis to neck; left: right to left
+    shoulder, made orthogonal to up)."""
+    joints = positions[identify_rig(skeleton).body17_indices(skeleton)]
+    at = dict(zip(body17.BODY17, joints, strict=True))
     up = at["neck"] - at["pelvis"]
     up /= np.linalg.norm(up)
     left = at["l_shoulder"] - at["r_shoulder"]
     left -= (left @ up) * up
     left /= np.linalg.norm(left)
     return np.stack([np.cross(left, up), left, up], axis=1)
+
+
+def rest_body_frame(skeleton: Skeleton) -> np.ndarray:
+    """:func:`body_frame` of ``skeleton``'s rest pose.
+
+    Near the identity for a rig whose rest pose stands facing +X (the avatar rig, CMU, the
+    generator's); a rig stored lying or turned (Bandai's rest pose lies along +Y, as its
+    BVH's Y-up frame) gives the turn that stands it up.
+    """
+    return body_frame(skeleton.rest_positions(), skeleton)
 
 
 def stands_upright(skeleton: Skeleton) -> bool:

@@ -134,7 +134,8 @@ def avatargo(name: str, summary: str, offsets: str) -> Method:
                 f"{name} needs the three Vive trackers and their walk-in T-pose sample: "
                 "enable [devices] trackers = true"
             )
-        synth = AvatarGo(inputs.rig, inputs.walk_in, offsets=offsets)
+        headset = inputs.calibration[0] if inputs.calibration else None
+        synth = AvatarGo(inputs.rig, inputs.walk_in, offsets=offsets, headset=headset)
         synth.name = name
         return synth
 

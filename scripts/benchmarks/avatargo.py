@@ -22,7 +22,8 @@ from render_cams.vr import FULL_BODY
 from scripts.benchmarks import BenchRow, best_of
 from scripts.stages.devices import REALISTIC_NOISE
 from synthesis.avatargo import AvatarGo
-from synthesis.avatargo.study import sample_user, setup_for, walk_in
+from synthesis.avatargo.study import sample_user, setup_for
+from synthesis.avatargo.walk_in import walk_in
 from synthesis.base import FrameBatch, on_clock
 from synthesis.ik_baseline import IKBaseline
 from synthesis.scoring import step_latencies_ms
@@ -51,7 +52,7 @@ def run(quick: bool = False) -> list[BenchRow]:
     user = sample_user(0, truth.skeleton)
     setup = setup_for(user, REALISTIC_NOISE)
     stream = setup.sample(truth, seed=user.seed)
-    synth = AvatarGo(truth.skeleton, walk_in(setup, truth.skeleton, user.seed, user.heading_rad))
+    synth = AvatarGo(truth.skeleton, walk_in(setup, truth, user.seed, user.heading_rad))
     baseline = IKBaseline(truth.skeleton, None)
     clocked = on_clock(stream)
     batch = FrameBatch.of_stream(clocked)

@@ -10,9 +10,8 @@ from render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
 from render_cams.vr.dropouts import Dropouts
 from render_cams.vr.noise import Drift, Latency, PositionJitter, RotationJitter
 from scripts.run_context import RunContext
-from scripts.scenario import Scenario, ScenarioError
-from synthesis.avatargo.calibration import NotTPoseError, classes_of, identify_roles
-from synthesis.avatargo.study import walk_in
+from scripts.scenario import Scenario
+from synthesis.avatargo.walk_in import walk_in
 
 METRICS = {
     "vr_valid_frac": "share of valid VR samples over all devices",
@@ -59,29 +58,6 @@ def record_kinect(ctx: RunContext) -> None:
     }
 
 
-def check_walk_in(ctx: RunContext) -> None:
-    """Refuse, before synthesis, a walk-in that AvatarGo cannot calibrate on: the T-pose is
-    the source rig's rest pose, and a rig whose rest pose is not one (Bandai's BVH rest
-    pose has the arms down) gives none.
-
-    Raises:
-        ScenarioError: an AvatarGo method is selected and the rest pose is no T-pose.
-    """
-    methods = ctx.scenario.synthesis.methods if ctx.scenario.synthesis is not None else ()
-    if not set(methods) & {"avatargo", "avatargo-fixed"}:
-        return
-    sample = ctx.walk_in
-    positions = np.where(np.asarray(sample.valid)[:, None], sample.positions, np.nan)
-    try:
-        identify_roles(positions, sample.quaternions, classes_of(sample.device_names))
-    except NotTPoseError as exc:
-        raise ScenarioError(
-            f"AvatarGo's walk-in is the source rig's rest pose, and that is no T-pose ({exc}); "
-            "evaluate AvatarGo on this clip with `avatarsim eval avatargo --library FOLDER`, "
-            "which retargets onto the avatar rig first, or leave it out of [synthesis] methods"
-        ) from exc
-
-
 def run(ctx: RunContext) -> None:
     if ctx.scenario.devices is None:
         return
@@ -93,8 +69,7 @@ def run(ctx: RunContext) -> None:
     stream = vr.sample(ctx.motion, seed=ctx.scenario.seed)
     ctx.vr_stream = stream
     if ctx.scenario.devices.trackers:  # AvatarGo's walk-in T-pose, with the same devices
-        ctx.walk_in = walk_in(vr, ctx.motion.skeleton, ctx.scenario.seed)
-        check_walk_in(ctx)
+        ctx.walk_in = walk_in(vr, ctx.motion, ctx.scenario.seed)
     ctx.metrics["vr_valid_frac"] = float(stream.valid.mean())
     ctx.info.setdefault("devices", {}).update(
         {

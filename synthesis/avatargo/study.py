@@ -31,16 +31,13 @@ from avatar_models.body import build_body
 from avatar_models.rigs import identify_rig
 from render_cams.vr import FULL_BODY, Attachment, NoiseModel, VRSetup, nominal_attachment
 from synthesis.avatargo.synthesizer import AvatarGo
-from synthesis.base import TrackingFrame
-from synthesis.ik_baseline import rest_body_frame, stands_upright
+from synthesis.avatargo.walk_in import t_pose, walk_in
 
 LIMB_SPREAD = 0.10
 """Avatar leg and arm lengths over the user's: uniform in ``1 +- LIMB_SPREAD`` (issue 13)."""
 STRAP_MAX_M = 0.05
 """Largest distance of a tracker from its nominal spot on the body (issue 13)."""
 TRACKERS = ("left_foot_tracker", "right_foot_tracker", "back_tracker")
-WALK_IN_S = 0.5
-"""How long the user stands in the T-pose before the trigger (the sample is the last one)."""
 STANDING_KNEE_DEG = 30.0
 """The user stands where both knees are flexed less than this from the rest pose (our
 choice: the generator's idle stance keeps soft knees at 23 deg)."""
@@ -94,40 +91,9 @@ def avatar_of(skeleton: Skeleton, user: SimulatedUser) -> Skeleton:
     return build_body(skeleton, segment_scale=scale).skeleton
 
 
-def t_pose(skeleton: Skeleton, heading_rad: float, seconds: float = WALK_IN_S) -> Motion:
-    """``skeleton`` standing still in its rest T-pose at the origin, feet on the floor,
-    turned to ``heading_rad``, for ``seconds`` at 90 Hz.
-
-    A rig whose rest pose does not stand facing +X (Bandai's lies along +Y) is first turned
-    upright (:func:`~synthesis.ik_baseline.rest_body_frame`) with its lowest joint on the
-    floor; an upright rig stands on its body's feet (:func:`build_body`'s root height, as
-    the avatar's in :class:`~synthesis.avatargo.synthesizer.AvatarGo`)."""
-    frames = int(round(seconds * 90.0)) + 1
-    heading = quat.from_axis_angle(np.array([0.0, 0.0, 1.0]), np.array(heading_rad))
-    if stands_upright(skeleton):
-        stand, height = quat.IDENTITY, build_body(skeleton).root_height
-    else:
-        stand = quat.from_matrix(rest_body_frame(skeleton).T)
-        height = -quat.rotate(stand, skeleton.rest_positions())[:, 2].min()
-    local = np.tile(quat.IDENTITY, (frames, skeleton.n_joints, 1))
-    local[:, 0] = quat.mul(heading, stand)
-    root = np.tile([0.0, 0.0, height], (frames, 1))
-    return Motion(skeleton, 90.0, root, local)
-
-
 def setup_for(user: SimulatedUser, noise: tuple[NoiseModel, ...] = ()) -> VRSetup:
     """The six devices with the user's straps and ``noise``."""
     return VRSetup(devices=FULL_BODY, noise=noise, offsets=user.straps)
-
-
-def walk_in(
-    setup: VRSetup, skeleton: Skeleton, seed: int, heading_rad: float = 0.0
-) -> TrackingFrame:
-    """The devices' last sample while a user of ``skeleton`` stands in the T-pose facing
-    ``heading_rad`` (the trigger press), sampled by ``setup`` with ``seed`` (the seed of the
-    session's stream, so that the devices sit where they sit during the session)."""
-    stream = setup.sample(t_pose(skeleton, heading_rad), seed=seed)
-    return TrackingFrame.from_stream(stream, stream.n_samples - 1)
 
 
 def knee_angle(positions: np.ndarray, skeleton: Skeleton) -> np.ndarray:
@@ -158,7 +124,7 @@ def reference(truth: Motion, user: SimulatedUser, synth: AvatarGo) -> np.ndarray
     rig = identify_rig(truth.skeleton)
     joints = truth.skeleton.indices([rig.body17[j] for j in EFFECTORS.values()])
     pos, rot = truth.fk()
-    user0 = t_pose(truth.skeleton, user.heading_rad, 0.0).global_positions()[0, joints]
+    user0 = t_pose(truth, user.heading_rad, 0.0).global_positions()[0, joints]
     avatar = synth.body.skeleton
     arig = synth.body.rig
     placed = synth.t_pose_positions()[avatar.indices([arig.body17[j] for j in EFFECTORS.values()])]
@@ -202,7 +168,7 @@ def study_run(
     if truth.fps != 90.0:
         truth = truth.resample(90.0)  # the output's clock, frame for frame
     setup = setup_for(user, noise)
-    sample = walk_in(setup, truth.skeleton, user.seed, user.heading_rad)
+    sample = walk_in(setup, truth, user.seed, user.heading_rad)
     stream = setup.sample(truth, seed=user.seed)
     avatar = avatar_of(truth.skeleton, user)
     out: dict = {"user": user.as_dict(), "motions": {}}

@@ -5,9 +5,10 @@ Construction is the Walk-In-Avatar step (§3.2-3.3) on one T-pose sample of the 
 
 1. roles and eye height from the plane through the devices
    (:func:`~synthesis.avatargo.calibration.identify_roles`);
-2. the avatar scaled uniformly so that its eye height is the headset's, stood in its
-   T-pose where the user stands, facing where the user faces, the headset centred in its
-   head (the user "walks into" it; in simulation we place the avatar on the user instead);
+2. the avatar scaled uniformly so that its head is as high as the user's under the
+   headset (the eye height less the headset's mount, :func:`head_under`), stood in its
+   T-pose where the user stands, facing where the user faces, its head where the user's
+   is (the user "walks into" it; in simulation we place the avatar on the user instead);
 3. the offsets of the joints in their devices' frames at t = 0: exact ones for the root,
    feet and head (eqs. 2-3, :func:`~synthesis.avatargo.offsets.exact_offsets`; §3.3 names
    root and feet and takes the head's rotation from the headset, we give the head's
@@ -44,8 +45,7 @@ from avatar_models.body import BodyDescription, build_body
 from avatar_models.body.ik import HumanoidIK, IKSettings, motion_from_qpos
 from avatar_models.rigs import identify_rig
 from render_cams import TrackingStream
-from render_cams.vr import FULL_BODY, nominal_attachment
-from render_cams.vr.placements import EYE_OFFSET_M
+from render_cams.vr import FULL_BODY, Attachment, nominal_attachment
 from synthesis.avatargo.calibration import Roles, classes_of, identify_roles
 from synthesis.avatargo.fingers import FingerIK
 from synthesis.avatargo.hands import (
@@ -112,12 +112,20 @@ class Calibration:
     spine0: np.ndarray
 
 
-def eye_height(body: BodyDescription) -> float:
-    """Height of the headset's eye point (:data:`~render_cams.vr.placements.EYE_OFFSET_M`
-    on the head) of ``body`` standing in its rest pose."""
+def head_height(body: BodyDescription) -> float:
+    """Height of the head joint of ``body`` standing in its rest pose."""
     sk = body.skeleton
-    head = sk.rest_positions()[sk.index(body.rig.body17["head"])]
-    return body.root_height + head[2] + EYE_OFFSET_M[2]
+    return body.root_height + sk.rest_positions()[sk.index(body.rig.body17["head"])][2]
+
+
+def head_under(position: np.ndarray, rotation: np.ndarray, headset: Attachment) -> np.ndarray:
+    """``(3,)`` the head joint under a headset at ``position (3,)``, wxyz ``rotation (4,)``
+    mounted on the head as ``headset`` (device pose in the head's frame):
+    ``p_head = p_hmd - R_hmd R_mount^-1 p_mount``. The joint frame's convention cancels
+    (a mount re-expressed in a turned frame, :func:`~synthesis.ik_baseline.
+    attachments_on_upright_rig`, gives the same head)."""
+    back = quat.rotate(quat.conj(headset.rotation), headset.position)
+    return position - quat.rotate(quat.normalize(rotation), back)
 
 
 def _first_usable(values: np.ndarray, ok: np.ndarray, last: np.ndarray) -> np.ndarray:
@@ -138,6 +146,10 @@ class AvatarGo(Synthesizer):
         walk_in: the T-pose sample of the six devices (any order; the names say only each
             device's class, :func:`~synthesis.avatargo.calibration.device_class`).
         offsets: ``"exact"`` (AvatarGo) or ``"fixed"`` (the baseline for root and feet).
+        headset: how the headset sits on the user's head (device pose in the head joint's
+            frame); None: the nominal mount (:func:`~render_cams.vr.nominal_attachment`).
+            The walk-in centres the avatar's head under the headset and scales the avatar
+            by the head's height (§3.2: the user walks into the avatar, eyes in its eyes).
         fingers: pose the fingers on the controllers (when the avatar has finger bones).
         iterations_per_tick: QP iterations per tick after the first.
 
@@ -153,6 +165,7 @@ class AvatarGo(Synthesizer):
         avatar: Skeleton,
         walk_in: TrackingFrame,
         offsets: str = "exact",
+        headset: Attachment | None = None,
         fingers: bool = True,
         iterations_per_tick: int = ITERATIONS_PER_TICK,
     ):
@@ -162,10 +175,13 @@ class AvatarGo(Synthesizer):
         positions = np.where(np.asarray(walk_in.valid)[:, None], walk_in.positions, np.nan)
         roles = identify_roles(positions, walk_in.quaternions, classes_of(walk_in.device_names))
         self.devices = tuple(walk_in.device_names[i] for i in roles.index)
-        scale = roles.eye_height_m / eye_height(build_body(avatar))
+        hmd = roles.index[0]
+        headset = nominal_attachment("hmd", avatar) if headset is None else headset
+        head = head_under(positions[hmd], walk_in.quaternions[hmd], headset)
+        scale = head[2] / head_height(build_body(avatar))
         self.body = build_body(avatar.scaled(scale))
         self.grip: Grip = grip_of(self.body.skeleton)
-        self.calibration = self._calibrate(roles, scale, positions, walk_in.quaternions)
+        self.calibration = self._calibrate(roles, scale, head, positions, walk_in.quaternions)
         self.iterations_per_tick = int(iterations_per_tick)
         self.ik = HumanoidIK(
             self.body.model,
@@ -192,9 +208,15 @@ class AvatarGo(Synthesizer):
 
     # -- walk-in ----------------------------------------------------------------------------
     def _calibrate(
-        self, roles: Roles, scale: float, positions: np.ndarray, quaternions: np.ndarray
+        self,
+        roles: Roles,
+        scale: float,
+        head: np.ndarray,
+        positions: np.ndarray,
+        quaternions: np.ndarray,
     ) -> Calibration:
-        """§3.2-3.3 on the role-ordered walk-in sample (see :class:`Calibration`)."""
+        """§3.2-3.3 on the role-ordered walk-in sample, the user's head at ``head (3,)``
+        (see :class:`Calibration`)."""
         sk = self.body.skeleton
         rig = identify_rig(sk)
         heading = roles.heading
@@ -202,9 +224,8 @@ class AvatarGo(Synthesizer):
         joint = {n: rest[sk.index(rig.body17[n])] for n in SITES}
         p = positions[roles.index]
         q = quat.normalize(np.asarray(quaternions, float)[roles.index])
-        eye = EYE_OFFSET_M * scale
-        # The headset centred in the avatar's head, the feet on the floor (§3.2).
-        root = p[0] - quat.rotate(heading, joint["head"] + eye)
+        # The avatar's head where the user's is, the feet on the floor (§3.2).
+        root = head - quat.rotate(heading, joint["head"])
         root[2] = self.body.root_height
         placed = {n: root + quat.rotate(heading, v) for n, v in joint.items()}
         role = dict(zip(FULL_BODY, range(len(FULL_BODY)), strict=True))

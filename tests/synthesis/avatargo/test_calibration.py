@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
+from avatar_models import Motion, quat
 from avatar_models.generator import sample_subject
 from avatar_models.generator.subject import subject_skeleton
 from render_cams.vr import FULL_BODY, VRSetup
@@ -20,14 +20,22 @@ from synthesis.avatargo.calibration import (
     classes_of,
     identify_roles,
 )
-from synthesis.avatargo.study import sample_user, setup_for, t_pose, walk_in
+from synthesis.avatargo.study import sample_user, setup_for
+from synthesis.avatargo.walk_in import t_pose, walk_in
 
 
 def _sample(seed: int = 0):
     """A random user's walk-in sample: straps up to 5 cm off and turned at random."""
+    motion = _still(seed)
+    user = sample_user(seed, motion.skeleton)
+    return walk_in(setup_for(user), motion, user.seed, user.heading_rad), user
+
+
+def _still(seed: int) -> Motion:
+    """One frame of a random subject in its rest pose (a T-pose: the walk-in stands in it)."""
     skeleton = subject_skeleton(sample_subject(np.random.default_rng(seed)))
-    user = sample_user(seed, skeleton)
-    return walk_in(setup_for(user), skeleton, user.seed, user.heading_rad), user
+    rest = np.tile(quat.IDENTITY, (1, skeleton.n_joints, 1))
+    return Motion(skeleton, 90.0, np.zeros((1, 3)), rest)
 
 
 @pytest.mark.parametrize("seed", range(3))
@@ -73,8 +81,7 @@ def test_missing_tracker_is_named():
 
 def test_arms_down_is_not_a_t_pose():
     """Hands lowered to the hips: not a T-pose, and the message says what to do."""
-    skeleton = subject_skeleton(sample_subject(np.random.default_rng(0)))
-    stream = VRSetup(devices=FULL_BODY).sample(t_pose(skeleton, 0.0), seed=0)
+    stream = VRSetup(devices=FULL_BODY).sample(t_pose(_still(0), 0.0), seed=0)
     positions = stream.positions[0].copy()
     hands = [FULL_BODY.index("left_controller"), FULL_BODY.index("right_controller")]
     positions[hands, 1] *= 0.2  # hands at the hips' width

@@ -10,7 +10,8 @@ from avatar_models.generator.subject import Subject
 from avatar_models.rigs import load_rig
 from render_cams.vr import nominal_attachment
 from synthesis.avatargo.hands import CONTROLLER_RADIUS_M, grip_of, out_of_reach
-from synthesis.avatargo.study import SimulatedUser, study_run, t_pose
+from synthesis.avatargo.study import SimulatedUser, study_run
+from synthesis.avatargo.walk_in import t_pose
 
 
 def test_grip_holds_the_handle_under_the_palm():
@@ -33,7 +34,7 @@ def test_short_arms_attach_the_controller():
     """Avatar arms 10 % short, a user holding the T-pose (arms straight out): the controllers
     are out of reach (the virtual controller is then in the hand, off the tracked one); the
     same user with the avatar's arms as long as theirs reaches them."""
-    truth = t_pose(generate("wave", Subject(), 0.1, 90.0, 0).skeleton, 0.0, 0.5)
+    truth = t_pose(generate("wave", Subject(), 0.1, 90.0, 0), 0.0, 0.5)
     short = study_run(truth, SimulatedUser(0, 1.0, 0.9, 0.0), fingers=False)["exact"]
     same = study_run(truth, SimulatedUser(0, 1.0, 1.0, 0.0), fingers=False)["exact"]
     assert short["unreached_frac"] > 0.0 and same["unreached_frac"] == 0.0

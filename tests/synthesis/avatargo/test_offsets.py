@@ -11,8 +11,9 @@ from avatar_models.generator import generate
 from avatar_models.generator.subject import Subject
 from render_cams.vr import Attachment
 from synthesis.avatargo.offsets import exact_offsets, fixed_offsets
-from synthesis.avatargo.study import EFFECTORS, ideal_user, reference, setup_for, walk_in
+from synthesis.avatargo.study import EFFECTORS, ideal_user, reference, setup_for
 from synthesis.avatargo.synthesizer import AvatarGo
+from synthesis.avatargo.walk_in import walk_in
 from synthesis.base import FrameBatch, on_clock
 
 
@@ -50,7 +51,7 @@ def test_exact_reconstruction_at_zero_offset_and_noise():
     user = ideal_user(0, heading_rad=0.7)
     setup = setup_for(user)
     synth = AvatarGo(
-        truth.skeleton, walk_in(setup, truth.skeleton, user.seed, user.heading_rad), fingers=False
+        truth.skeleton, walk_in(setup, truth, user.seed, user.heading_rad), fingers=False
     )
     stream = on_clock(setup.sample(truth, seed=0))
     index = synth.device_index(FrameBatch.of_stream(stream))

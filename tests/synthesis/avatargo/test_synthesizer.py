@@ -9,7 +9,8 @@ import pytest
 from avatar_models.generator import generate
 from avatar_models.generator.subject import Subject
 from synthesis.avatargo import AvatarGo
-from synthesis.avatargo.study import sample_user, setup_for, walk_in
+from synthesis.avatargo.study import sample_user, setup_for
+from synthesis.avatargo.walk_in import walk_in
 from synthesis.base import SynthesisError, TrackingFrame
 from synthesis.methods import MethodInputs, build
 
@@ -19,7 +20,7 @@ def session():
     truth = generate("wave", Subject(), 0.25, 90.0, 0)
     user = sample_user(5, truth.skeleton)
     setup = setup_for(user)
-    sample = walk_in(setup, truth.skeleton, user.seed, user.heading_rad)
+    sample = walk_in(setup, truth, user.seed, user.heading_rad)
     return truth, sample, setup.sample(truth, seed=user.seed)
 
 
