@@ -161,6 +161,7 @@ class FingerIK:
         self.t = np.zeros((n, 3))
         self._eta = np.full(n, LEARNING_RATE)
         self._settled = False
+        self._converged = False
 
     def sdf(self, t: np.ndarray) -> np.ndarray:
         """``(..., F, 3)`` signed distance of each finger point to its handle."""
@@ -185,12 +186,19 @@ class FingerIK:
             trial = np.clip(self.t - self._eta[:, None] * grad, 0.0, 1.0)
             better = self.cost(trial) < costs[0]
             self.t = np.where(better[:, None], trial, self.t)
+            self._converged = not better.any()
             grown = np.minimum(1.5 * self._eta, MAX_LEARNING_RATE)
             self._eta = np.where(better, grown, 0.5 * self._eta)
         return self.t
 
     def advance(self) -> np.ndarray:
-        """One frame's solve (the first settles from the open hand): ``t (F, 3)``."""
+        """One frame's solve (the first settles from the open hand): ``t (F, 3)``.
+
+        The handles sit still in the hand frames (:class:`~synthesis.avatargo.hands.Grip`)
+        and the thumb goal is fixed, so the problem is the same every frame: once a round of
+        steps improves no finger, the pose is held without probing (the 1 ms aim)."""
+        if self._converged:
+            return self.t
         steps = self.iterations_per_tick if self._settled else SETTLE_ITERATIONS
         self._settled = True
         # A finger whose step size collapsed has converged; let it probe again each frame.

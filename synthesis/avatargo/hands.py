@@ -118,9 +118,9 @@ def palm_distance(
     wrist_pos: np.ndarray, wrist_rot: np.ndarray, controller_pos: np.ndarray, grip: Grip
 ) -> np.ndarray:
     """``(B, 2)`` metres from the palm's controller point of the solved wrists
-    (``wrist_pos (B, 2, 3)``, ``wrist_rot (B, 2, 4)``) to the tracked controllers
-    ``(B, 2, 3)``."""
-    held = wrist_pos + quat.rotate(wrist_rot, grip.palm)
+    (``wrist_pos (B, 2, 3)``, rotation matrices ``wrist_rot (B, 2, 3, 3)``) to the tracked
+    controllers ``(B, 2, 3)``."""
+    held = wrist_pos + (wrist_rot @ grip.palm[..., None])[..., 0]
     return np.linalg.norm(held - controller_pos, axis=-1)
 
 

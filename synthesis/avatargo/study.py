@@ -160,10 +160,15 @@ def score(truth: Motion, output: Motion, user: SimulatedUser, synth: AvatarGo) -
 
 
 def study_run(
-    truth: Motion, user: SimulatedUser, noise: tuple[NoiseModel, ...] = (), fingers: bool = True
+    truth: Motion,
+    user: SimulatedUser,
+    noise: tuple[NoiseModel, ...] = (),
+    fingers: bool = True,
+    solver: str = "mink",
 ) -> dict:
     """``truth`` performed by ``user`` wearing the six devices with ``noise``; AvatarGo with
-    exact and with fixed offsets on the user's avatar. Returns per variant :func:`score`
+    exact and with fixed offsets on the user's avatar, its IK by ``solver``
+    (:data:`~synthesis.avatargo.synthesizer.SOLVERS`). Returns per variant :func:`score`
     (the outputs under ``"motions"``)."""
     if truth.fps != 90.0:
         truth = truth.resample(90.0)  # the output's clock, frame for frame
@@ -173,7 +178,7 @@ def study_run(
     avatar = avatar_of(truth.skeleton, user)
     out: dict = {"user": user.as_dict(), "motions": {}}
     for kind in ("exact", "fixed"):
-        synth = AvatarGo(avatar, sample, offsets=kind, fingers=fingers)
+        synth = AvatarGo(avatar, sample, offsets=kind, fingers=fingers, solver=solver)
         motion = synth.run(stream)
         out[kind] = score(truth, motion, user, synth)
         out["motions"][kind] = motion

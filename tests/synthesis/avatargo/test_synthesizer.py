@@ -49,3 +49,9 @@ def test_step_is_run_and_lost_devices_hold(session):
     np.testing.assert_allclose(np.stack([p.root_pos for p in steps]), batch.root_pos, atol=1e-9)
     np.testing.assert_allclose(np.stack([p.local_rot for p in steps]), batch.local_rot, atol=1e-9)
     assert np.isfinite(batch.local_rot).all() and np.isfinite(batch.root_pos).all()
+
+
+def test_unknown_solver_is_refused(session):
+    truth, sample, _ = session
+    with pytest.raises(SynthesisError, match="solver must be one of"):
+        AvatarGo(truth.skeleton, sample, solver="unity")
