@@ -91,7 +91,7 @@ class LeastSquaresIK(HumanoidIK):
         hessian = a.T @ a
         hessian[np.diag_indices_from(hessian)] += self._posture + s.damping + s.lm_damping * (e @ e)
         gradient = a.T @ e + self._posture * toward
-        dq = cho_solve(cho_factor(hessian, check_finite=False), gradient)
+        dq = cho_solve(cho_factor(hessian, check_finite=False), gradient, check_finite=False)
         # Hinges the step would take out of range stay at their bound, the rest re-solved,
         # until none leaves its range (an active set that only grows: a few passes).
         hinge = data.qpos[ROOT_NQ:]
@@ -106,7 +106,9 @@ class LeastSquaresIK(HumanoidIK):
             dq[h + ROOT_NV] = np.clip(stepped[h], self._lower[h], self._upper[h]) - hinge[h]
             free = np.concatenate([np.arange(ROOT_NV), np.flatnonzero(~held) + ROOT_NV])
             rhs = gradient[free] - hessian[np.ix_(free, h + ROOT_NV)] @ dq[h + ROOT_NV]
-            dq[free] = cho_solve(cho_factor(hessian[np.ix_(free, free)], check_finite=False), rhs)
+            dq[free] = cho_solve(
+                cho_factor(hessian[np.ix_(free, free)], check_finite=False), rhs, check_finite=False
+            )
         q = data.qpos.copy()
         mujoco.mj_integratePos(model, q, dq, 1.0)
         self.configuration.update(np.clip(q, self.qpos_lower, self.qpos_upper))
