@@ -69,12 +69,11 @@ def run(quick: bool = False) -> list[BenchRow]:
         goals_s = best_of(lambda: synth.goals(pos, rot), repeat=50)
         goal_pos, goal_rot = synth.goals(pos, rot)
         solve_s = {}
-        for solver, s in synths.items():  # warm: from the pose that meets these goals
-            start, _, _ = s.ik.solve_frame(
-                goal_pos[0], s.ik.fitted_root(goal_pos[0]), goal_rot[0], 40
-            )
+        fit = synth.ik.fitted_root(goal_pos[0])
+        warm, _, _ = synth.ik.solve_frame(goal_pos[0], fit, goal_rot[0], 40)  # meets the goals
+        for solver, s in synths.items():
             solve_s[solver] = best_of(
-                lambda s=s, q=start: s.ik.solve_frame(
+                lambda s=s, q=warm: s.ik.solve_frame(
                     goal_pos[0], q, goal_rot[0], ITERATIONS_PER_TICK
                 ),
                 repeat=20,
