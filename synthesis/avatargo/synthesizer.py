@@ -20,9 +20,11 @@ Construction is the Walk-In-Avatar step (§3.2-3.3) on one T-pose sample of the 
 
 Each tick (§3.4): end-effector goals for the root (pelvis), ankles and head from the
 offsets, the spine's bend ``alpha_t`` (eq. 4) as the neck's goal, the wrists from the
-controllers; then full-body IK with mink on the avatar's humanoid
-(:class:`~avatar_models.body.ik.HumanoidIK`, warm-started, a few QP iterations, standing in
-for Unity's IK), and finger IK on the controller handles (:mod:`synthesis.avatargo.fingers`)
+controllers (after the first tick at the controller less the palm offset turned by the
+wrist's solved rotation, see :data:`ORIENTATION_COST`); then full-body IK with mink on the
+avatar's humanoid (:class:`~avatar_models.body.ik.HumanoidIK`, warm-started, a few QP
+iterations, standing in for Unity's IK; or damped least squares, :data:`SOLVERS`), and
+finger IK on the controller handles (:mod:`synthesis.avatargo.fingers`)
 when the avatar has the avatar rig's finger bones. Where a controller is out of the arm's
 reach (:func:`~synthesis.avatargo.hands.out_of_reach`), the virtual controller is drawn in
 the hand (reported per frame by :attr:`AvatarGo.attached`, with

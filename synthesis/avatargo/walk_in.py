@@ -38,8 +38,8 @@ off)."""
 SIDEWAYS = {"l": np.array([0.0, 1.0, 0.0]), "r": np.array([0.0, -1.0, 0.0])}
 DOWN = np.array([0.0, 0.0, -1.0])
 HALF_TURN_AXIS = np.array([0.0, 1.0, 0.0])
-"""A bone pointing opposite its aim (Bandai's up-pointing leg) turns through the front,
-about the body's left axis."""
+"""A bone pointing exactly opposite its aim (an arm raised straight up) turns through the
+front, about the body's left axis."""
 
 
 def limb_chains(skeleton: Skeleton) -> dict[str, list[int]]:

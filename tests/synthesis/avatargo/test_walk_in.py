@@ -59,9 +59,9 @@ def _body17(motion, names):
 def test_walk_in_on_a_real_clip_calibrates(mocap_dir: Path, source):
     """On a clip of each source, facing 40 deg: the arms stretch sideways at shoulder height
     (wrists within 5 cm of the shoulders' height, as far apart along the left axis as the
-    shoulders plus both arms' bones, to 2 cm), the ankles under the hips, left of right (10 cm), the
-    lowest joint on the floor (2 cm; CMU stands on its body's feet); the
-    walk-in sample identifies every device's role and the facing to 3 deg (measured 0.96,
+    shoulders plus both arms' bones, to 2 cm), the ankles under the hips, left of right
+    (10 cm), the lowest joint on the floor (2 cm; CMU stands on its body's feet); the walk-in
+    sample identifies every device's role and the facing to 3 deg (measured 0.96,
     1.30, 0.21 deg for Bandai-1, Bandai-2, CMU; no noise, so no seed dependence: the plane
     fit's tilt from the arms' and legs' own offsets)."""
     motion = read_bvh(mocap_dir / REAL_CLIPS[source])[:30]
