@@ -4,9 +4,15 @@ data is captured and then mapped to the corresponding joint in the RocketBox ava
 A :class:`BoneDrive` says, for one avatar joint (whose rotation turns the bone to its
 ``child``): the Kinect joint the bone points at (``aim``), and the Kinect joint whose reported
 orientation gives the bone's roll (``orient``), with the Kinect rest bone that orientation
-turns (``orient_rest``: from, to). Kinect V2 reports, at each joint, the rotation of the bone
-that *ends* there (a swing with no roll, paper §IV-A1); Azure Kinect the rotation of the bone
-that *starts* there. The pelvis is set by its triad (spine base and both hips), which fixes
+turns (``orient_rest``: from, to). Limbs and clavicles aim from where the avatar's chain puts
+the bone's start (the avatar's hand lands on the user's whatever the arm lengths); spine and
+neck bones take the direction of the Kinect bone itself (``aim_from``), as the paper's joint
+orientations would: the avatar's torso is not the user's length (a height-resized avatar's
+pelvis-to-neck is 38 cm where a CMU subject's is 24 cm), and a spine bone aimed from the
+avatar's start at a Kinect joint it has already passed folds down (measured on CMU 14_33,
+noise-free: Spine2 up to 127 degrees from up). Kinect V2 reports, at each joint, the rotation
+of the bone that *ends* there (a swing with no roll, paper §IV-A1); Azure Kinect the rotation
+of the bone that *starts* there. The pelvis is set by its triad (spine base and both hips), which fixes
 its heading on both sensors (V2's root orientation has none).
 
 Avatar bones without a drive (fingers, toes, jaw, eyelids, V2's head, stabilised wrists)
@@ -32,6 +38,8 @@ class BoneDrive:
         orient_rest: the Kinect rest bone (from, to) that ``orient``'s orientation turns.
         bend: for a bone whose child is a hinge (elbow, knee), the direction the child's far
             end moves when the hinge flexes, in this bone's rest frame; else None.
+        aim_from: the Kinect joint at the bone's start, for a bone that takes the Kinect
+            bone's direction (``aim_from`` to ``aim``); None: aimed from the avatar's start.
     """
 
     joint: str
@@ -40,11 +48,12 @@ class BoneDrive:
     orient: str
     orient_rest: tuple[str, str]
     bend: tuple[float, float, float] | None = None
+    aim_from: str | None = None
 
     @property
     def kinect_joints(self) -> tuple[str, ...]:
         """The Kinect joints this bone reads (their tracking state is the bone's)."""
-        return tuple(j for j in (self.aim, self.orient) if j is not None)
+        return tuple(dict.fromkeys(j for j in (self.aim_from, self.aim, self.orient) if j))
 
 
 @dataclass(frozen=True)
@@ -74,6 +83,11 @@ PELVIS_TRIAD = ("Bip01 L Thigh", "Bip01 R Thigh")
 def _v2_drive(joint: str, child: str, start: str, end: str) -> BoneDrive:
     """A V2 bone from Kinect ``start`` to ``end``: aims at ``end``, roll from ``end``."""
     return BoneDrive(joint, child, end, end, (start, end))
+
+
+def _v2_spine_drive(joint: str, child: str, start: str, end: str) -> BoneDrive:
+    """A V2 spine bone: the direction of the Kinect bone ``start`` to ``end``."""
+    return replace(_v2_drive(joint, child, start, end), aim_from=start)
 
 
 def _azure_drive(joint: str, child: str, start: str, end: str | None, rest_end: str) -> BoneDrive:
@@ -121,10 +135,10 @@ KINECT_V2 = RigMapping(
     root="SpineBase",
     hips=("HipLeft", "HipRight"),
     drives=(
-        _v2_drive("Bip01 Spine", "Bip01 Spine1", "SpineBase", "SpineMid"),
-        _v2_drive("Bip01 Spine1", "Bip01 Spine2", "SpineMid", "SpineShoulder"),
-        _v2_drive("Bip01 Spine2", "Bip01 Neck", "SpineShoulder", "Neck"),
-        _v2_drive("Bip01 Neck", "Bip01 Head", "Neck", "Head"),
+        _v2_spine_drive("Bip01 Spine", "Bip01 Spine1", "SpineBase", "SpineMid"),
+        _v2_spine_drive("Bip01 Spine1", "Bip01 Spine2", "SpineMid", "SpineShoulder"),
+        _v2_spine_drive("Bip01 Spine2", "Bip01 Neck", "SpineShoulder", "Neck"),
+        _v2_spine_drive("Bip01 Neck", "Bip01 Head", "Neck", "Head"),
         *_limbs("L", _v2_side("L"), _v2_drive),
         *_limbs("R", _v2_side("R"), _v2_drive),
     ),
@@ -140,10 +154,31 @@ AZURE_KINECT = RigMapping(
     root="PELVIS",
     hips=("HIP_LEFT", "HIP_RIGHT"),
     drives=(
-        _azure_drive("Bip01 Spine", "Bip01 Spine1", "SPINE_NAVAL", "SPINE_NAVAL", "SPINE_CHEST"),
-        _azure_drive("Bip01 Spine1", "Bip01 Spine2", "SPINE_CHEST", "SPINE_CHEST", "NECK"),
-        _azure_drive("Bip01 Spine2", "Bip01 Neck", "SPINE_CHEST", "NECK", "NECK"),
-        _azure_drive("Bip01 Neck", "Bip01 Head", "NECK", "HEAD", "HEAD"),
+        # Spine bones: the Kinect bone's direction (aim_from to aim), roll from the joint
+        # whose rest bone runs up to the next spine joint.
+        *(
+            BoneDrive(joint, child, aim, orient, (orient, rest_end), aim_from=start)
+            for joint, child, start, aim, orient, rest_end in (
+                (
+                    "Bip01 Spine",
+                    "Bip01 Spine1",
+                    "PELVIS",
+                    "SPINE_NAVAL",
+                    "SPINE_NAVAL",
+                    "SPINE_CHEST",
+                ),
+                (
+                    "Bip01 Spine1",
+                    "Bip01 Spine2",
+                    "SPINE_NAVAL",
+                    "SPINE_CHEST",
+                    "SPINE_CHEST",
+                    "NECK",
+                ),
+                ("Bip01 Spine2", "Bip01 Neck", "SPINE_CHEST", "NECK", "SPINE_CHEST", "NECK"),
+                ("Bip01 Neck", "Bip01 Head", "NECK", "HEAD", "NECK", "HEAD"),
+            )
+        ),
         # The head's roll and nod: Azure's HEAD orientation turns the neck-head bone.
         BoneDrive("Bip01 Head", "Bip01 HeadNub", None, "HEAD", ("NECK", "HEAD")),
         *_limbs("L", _azure_side("L"), _azure_limb_drive),

@@ -16,9 +16,12 @@ q_absolute), gives it back. The absolute rotation of a bone:
    but also keeps the avatar's rest hinge axes of the elbows and knees: the upper arm and
    thigh take the roll that makes the measured bend of the forearm or calf a flexion of
    the hinge (the roll is then seen, not assumed, wherever the joint is bent).
-2. its direction: the smallest rotation that turns the bone (from where its parents put its
-   start) towards the Kinect joint it aims at, so the avatar's limbs point where the
-   user's do whatever the rig proportions.
+2. its direction: the smallest rotation that turns the bone towards the Kinect joint it
+   aims at: for limbs and clavicles from where its parents put its start, so the avatar's
+   limbs point where the user's do whatever the rig proportions; for spine and neck bones
+   from the Kinect joint at the bone's start (``BoneDrive.aim_from``: the Kinect bone's own
+   direction), so that an avatar torso longer than the user's stays straight instead of
+   folding back towards Kinect joints it has passed (:mod:`.mapping`).
 
 Unmapped joints keep their rest rotation relative to their parent. Wrist stabilisation
 (§IV-B2: "fix the wrist rotations and set them to match that of the lower arm") leaves the
@@ -205,6 +208,8 @@ class Retargeting:
         if drive.aim is None:
             return world
         bone = self.target.offsets[self.target.index(drive.child)]
+        if drive.aim_from is not None:
+            start = positions[:, self.kinect_index(drive.aim_from)]
         target = positions[:, self.kinect_index(drive.aim)] - start
         world = quat.mul(shortest_arc(rotate(world, bone), target), world)
         if self.roll == "hinge" and drive.bend is not None:
