@@ -145,11 +145,12 @@ def write_avatargo(results: dict, out: Path, json_out: Path | None) -> None:
 
 
 def _movebox_table(results: dict) -> Table:
-    """Means per source and sensor: Kinect joint error, retargeting (noise-free, noisy; cm),
-    roll (hinge/rest/sensor; deg), jerk (raw/smoothed; m/s^3), method error, loop seam."""
+    """Means per source and sensor: share of Kinect frames tracking every body17 joint,
+    Kinect joint error, retargeting (noise-free, noisy; cm), roll (hinge/rest/sensor; deg),
+    jerk (raw/smoothed; m/s^3), method error (every tick, tracked ticks), loop seam."""
     table = Table(title="movebox, means over takes (eval JSON: every number)")
-    for col in ("source", "sensor", "kin cm", "clean", "noisy", "roll h/r/s", "jerk", "full",
-                "seam"):  # fmt: skip
+    for col in ("source", "sensor", "trk", "kin cm", "clean", "noisy", "roll h/r/s", "jerk",
+                "full", "f trk", "seam"):  # fmt: skip
         table.add_column(col, justify="left" if col in ("source", "sensor") else "right")
     for source, sensors in results["summary"].items():
         for sensor, s in sensors.items():
@@ -162,12 +163,14 @@ def _movebox_table(results: dict) -> Table:
             table.add_row(
                 source,
                 sensor,
+                f"{s['tracked_frames_frac']:.0%}",
                 f"{r['kinect_err_cm']:.1f}",
                 f"{r['noise_free']:.2f}",
                 f"{r['noisy']:.1f}",
                 rolls,
                 f"{jerk['unsmoothed'] / 1e3:.0f}k/{jerk['smoothed'] / 1e3:.0f}k",
                 f"{s['method']['err_cm']['full']:.1f}",
+                f"{s['method']['err_cm_tracked']['full']:.1f}",
                 f"{s['loop_seam']['naive']:.1f}/{s['loop_seam']['trimmed']:.1f}",
             )
     return table

@@ -12,8 +12,8 @@ pelvis-to-neck is 38 cm where a CMU subject's is 24 cm), and a spine bone aimed 
 avatar's start at a Kinect joint it has already passed folds down (measured on CMU 14_33,
 noise-free: Spine2 up to 127 degrees from up). Kinect V2 reports, at each joint, the rotation
 of the bone that *ends* there (a swing with no roll, paper §IV-A1); Azure Kinect the rotation
-of the bone that *starts* there. The pelvis is set by its triad (spine base and both hips), which fixes
-its heading on both sensors (V2's root orientation has none).
+of the bone that *starts* there. The pelvis is set by its triad (spine base and both hips),
+which fixes its heading on both sensors (V2's root orientation has none).
 
 Avatar bones without a drive (fingers, toes, jaw, eyelids, V2's head, stabilised wrists)
 keep their rest rotation relative to their parent.
