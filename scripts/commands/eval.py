@@ -81,10 +81,12 @@ def _board_tables(board: dict) -> list[Table]:
 
 def write_leaderboard(board: dict, out: Path, json_out: Path | None) -> None:
     """Print the leaderboard; write its JSON, plot and page into ``out``."""
-    from scripts.leaderboard import render_page, write_plot
+    from scripts.leaderboard import render_page, tracked_notes, write_plot
 
     for table in _board_tables(board):
         console.print(table)
+    for note in tracked_notes(board):
+        console.print(escape(note))
     for fail in board["failed_folds"]:
         console.print(
             "[yellow]fold failed[/] "
