@@ -14,8 +14,9 @@ torso (``torso``; :meth:`~synthesis.movebox.retarget.Retargeting.torso_scaled`):
 height-resized avatar's torso is not the user's length (pelvis to neck 38 cm on the avatar
 resized to a CMU subject whose own is 24 cm), and a spine bone aimed from the avatar's start
 at a Kinect joint that start has already passed folds down (the 9 CMU clips, noise-free:
-Spine2 up to 118 degrees off the subject's own pelvis-neck line). Limbs and clavicles aim at the joints themselves, so that the
-avatar's hands land on the user's whatever the arm lengths.
+Spine2 up to 118 degrees off the subject's own pelvis-neck line). Limbs and clavicles aim at
+the joints themselves, so that the avatar's hands land on the user's whatever the arm
+lengths.
 
 Avatar bones without a drive (fingers, toes, jaw, eyelids, V2's head, stabilised wrists)
 keep their rest rotation relative to their parent.
