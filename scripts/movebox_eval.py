@@ -152,16 +152,22 @@ def shown_tracked(kinect: KinectSkeletonStream, ticks: np.ndarray) -> np.ndarray
     return (shown >= 0) & body17_tracked(kinect)[np.maximum(shown, 0)]
 
 
+def mean_cm(err_m: np.ndarray, frames: np.ndarray) -> float:
+    """Mean of ``err_m (T, ...)`` over ``frames (T,)`` bool, in cm; NaN over no frame (a
+    take that the sensor never tracks whole: a swimmer, CMU 126_01)."""
+    return float(100.0 * err_m[frames].mean()) if frames.any() else float("nan")
+
+
 def body17_err_cm(output: Motion, truth: Motion, frames: np.ndarray) -> float:
     err = np.linalg.norm(body17_positions(output) - body17_positions(truth), axis=-1)
-    return float(100.0 * err[frames].mean())
+    return mean_cm(err, frames)
 
 
 def kinect_err_cm(kinect: KinectSkeletonStream, truth: Motion, frames: np.ndarray) -> float:
     """Mean error of the stream's body17 joints against the truth's."""
     idx = load_rig(kinect.rig).body17_indices()
     err = np.linalg.norm(kinect.positions[:, idx] - body17_positions(truth), axis=-1)
-    return float(100.0 * err[frames].mean())
+    return mean_cm(err, frames)
 
 
 def roll_err_deg(output: Motion, truth: Motion, frames: np.ndarray) -> float:
@@ -195,15 +201,14 @@ def evaluate_sensor(
 ) -> dict:
     """Every number of the module docstring for one take and sensor. The Kinect films the
     take on its ``humanoid`` (a real clip's rig retargeted onto the avatar body, whose rest
-    pose stands); errors are against the take itself."""
+    pose stands); errors are against the take itself, NaN over tracked frames when there
+    are none (the share says so)."""
     truth = take.truth
     on_body = (humanoid.motion, sensor)
     clean = kinect_skeleton(*on_body, seed=seed, noise=None, body=humanoid.body)
     noisy = kinect_skeleton(*on_body, seed=seed, body=humanoid.body)
     truth30 = motion_at_rate(truth, clean.meta["rate_hz"])
     tracked = body17_tracked(noisy)
-    if not tracked.any():
-        raise SynthesisError(f"{take.label}: no {sensor} frame tracks every body17 joint")
     target = avatar_for(humanoid.body.skeleton, standing_height(humanoid.motion))
     uniform = resized_avatar(clean)
     row = {
@@ -285,7 +290,8 @@ def run_movebox_eval(
 
 
 def summarise(rows: dict, sensors) -> dict:
-    """Means over takes per sensor, split into built-in and real takes."""
+    """Means over takes per sensor, split into built-in and real takes; a number NaN on a
+    take (no tracked frame) is averaged over the other takes."""
     out = {}
     for source in ("builtin", "real"):
         chosen = [
@@ -302,7 +308,8 @@ def _mean_tree(rows: list[dict]):
     if isinstance(first, dict):
         keys = [k for k in first if all(k in r for r in rows) and not isinstance(first[k], list)]
         return {k: _mean_tree([r[k] for r in rows]) for k in keys}
-    return float(np.mean(rows))
+    defined = [v for v in rows if np.isfinite(v)]
+    return float(np.mean(defined)) if defined else float("nan")
 
 
 def audio_files(path: Path) -> list[Path]:

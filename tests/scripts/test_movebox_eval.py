@@ -16,7 +16,7 @@ from avatar_models.generator import generate
 from avatar_models.rigs import load_rig
 from render_cams.kinect import TrackingState, kinect_skeleton
 from scripts.cli import app
-from scripts.movebox_eval import shown_tracked
+from scripts.movebox_eval import mean_cm, shown_tracked, summarise
 from tests.synthesis.movebox.conftest import AUDIO_DIR
 
 runner = CliRunner()
@@ -74,6 +74,14 @@ def test_shown_tracked_is_the_latest_kinect_frame_at_or_before_each_tick(recorde
     ticks = np.array([-0.01, 0.0, 0.5, 1.0, 1.5, 2.0, 2.5]) * frame + stream.timestamps[0]
     shown = shown_tracked(stream, ticks)
     assert shown.tolist() == [False, True, True, False, False, True, True]
+
+
+def test_a_take_never_tracked_whole_has_nan_tracked_errors_left_out_of_the_means():
+    err = np.full((4, 17), 0.02)
+    assert mean_cm(err, np.ones(4, bool)) == pytest.approx(2.0)
+    assert np.isnan(mean_cm(err, np.zeros(4, bool)))
+    rows = {"a": {"s": {"e": 2.0}}, "b": {"s": {"e": float("nan")}}, "c": {"s": {"e": 4.0}}}
+    assert summarise(rows, ["s"])["real"]["s"]["e"] == pytest.approx(3.0)
 
 
 @pytest.mark.mocap
