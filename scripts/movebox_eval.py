@@ -210,14 +210,19 @@ def evaluate_sensor(
     truth30 = motion_at_rate(truth, clean.meta["rate_hz"])
     tracked = body17_tracked(noisy)
     target = avatar_for(humanoid.body.skeleton, standing_height(humanoid.motion))
-    uniform = resized_avatar(clean)
+    try:
+        uniform = resized_avatar(clean)
+    except SynthesisError:  # never a frame with the head and both feet tracked: NaN below
+        uniform = None
     row = {
         "tracked_frames_frac": float(tracked.mean()),
         "retarget_err_cm": {
             "noise_free": body17_err_cm(retargeted(clean, target, "hinge"), truth30, tracked),
             "noisy": body17_err_cm(retargeted(noisy, target, "hinge"), truth30, tracked),
             "kinect_err_cm": kinect_err_cm(noisy, truth30, tracked),
-            "resized_avatar": body17_err_cm(retargeted(clean, uniform, "hinge"), truth30, tracked),
+            "resized_avatar": float("nan")
+            if uniform is None
+            else body17_err_cm(retargeted(clean, uniform, "hinge"), truth30, tracked),
         },
     }
     if take.own_avatar:
