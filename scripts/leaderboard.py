@@ -28,7 +28,7 @@ from avatar_models.measure import standing_height
 from render_cams import VRSetup
 from render_cams.vr import FULL_BODY
 from scripts.method_score import score_method
-from scripts.movebox_eval import filmed
+from scripts.movebox_eval import body17_tracked, filmed
 from scripts.report_html import image_html, page, table_html
 from sim.thresholds import CheckConfig
 from synthesis.avatargo.walk_in import walk_in
@@ -86,6 +86,16 @@ RECORDERS: dict[str, Callable[[Motion, int], object]] = {
 needs an entry here to be on the leaderboard."""
 
 
+TRACKED_SHARE: dict[str, Callable[[object], float]] = {
+    "kinect": lambda kinect: float(body17_tracked(kinect).mean()),
+}
+"""For a recorded sensor that can lose the performer (out of its view or range): the share of
+a trial's frames in which it tracks every body17 joint. A method reading it holds the last
+pose elsewhere, so its error there grows with how far the performer went (CMU 102_01, a
+basketball drive: MoveBox 103 cm over every tick, 14 cm over the tracked ones); the board
+reports the share per class beside the errors (:func:`tracked_notes`)."""
+
+
 def sensors_of(methods: Sequence[str]) -> list[str]:
     """The sensors beyond the VR stream that ``methods`` read, in first-declared order.
 
@@ -114,20 +124,24 @@ def trial_row(result) -> dict[str, float]:
 
 
 def fold_rows(fold, setup: VRSetup, methods: Sequence[str], checks: CheckConfig, tune: bool):
-    """``[(class, method, row)]`` for every test trial of ``fold`` and every method, and
-    ``[{"method", "class", "reason"}]`` for each method that failed on a trial."""
+    """``[(class, method, row)]`` for every test trial of ``fold`` and every method,
+    ``[{"method", "class", "reason"}]`` for each method that failed on a trial, and
+    ``[(class, sensor, share)]``: each recorded sensor's :data:`TRACKED_SHARE` per trial."""
     coolmoves = METHODS["coolmoves"].options
     overrides = {}
     if tune:
         overrides["max_distance"] = choose_max_distance(fold.train, fold.protocol, coolmoves, setup)
     database = cache(lambda: database_for(fold.train))
     sensors = sensors_of(methods)
-    out, failures = [], []
+    out, failures, shares = [], [], []
     trackers = set(FULL_BODY) <= set(setup.devices)
     for trial in fold.test:
         stream = setup.sample(trial.motion, seed=trial.seed)
         rig, calibration = ik_rig_for(database().skeleton, trial.motion, setup)
         recordings = {s: RECORDERS[s](trial.motion, trial.seed) for s in sensors}
+        shares += [
+            (trial.cls, s, TRACKED_SHARE[s](r)) for s, r in recordings.items() if s in TRACKED_SHARE
+        ]
         inputs = MethodInputs(
             database,
             standing_height(trial.motion),
@@ -144,7 +158,37 @@ def fold_rows(fold, setup: VRSetup, methods: Sequence[str], checks: CheckConfig,
                 failures.append({"method": name, "class": trial.cls, "reason": str(exc)})
                 continue
             out.append((trial.cls, name, trial_row(result)))
-    return out, failures
+    return out, failures, shares
+
+
+def tracked_summary(shares: list[tuple[str, str, float]], methods: Sequence[str]) -> dict:
+    """``{sensor: {"methods", "per_class": {class: mean share}, "mean"}}`` of ``shares``
+    (``(class, sensor, share)`` per trial); ``mean`` over classes, as the errors are."""
+    out = {}
+    for sensor in dict.fromkeys(s for _, s, _ in shares):
+        classes = sorted({c for c, s, _ in shares if s == sensor})
+        per_class = {
+            c: float(np.mean([v for cc, s, v in shares if cc == c and s == sensor]))
+            for c in classes
+        }
+        out[sensor] = {
+            "methods": [m for m in methods if sensor in METHODS[m].sensors],
+            "per_class": per_class,
+            "mean": float(np.mean(list(per_class.values()))),
+        }
+    return out
+
+
+def tracked_notes(board: dict) -> list[str]:
+    """One line per sensor of ``board["sensor_tracked"]``: how much of the trials it tracked,
+    and which methods' errors that qualifies."""
+    return [
+        f"{sensor}: every body17 joint tracked in {t['mean']:.0%} of frames ("
+        + ", ".join(f"{c} {v:.0%}" for c, v in t["per_class"].items())
+        + f"); {', '.join(t['methods'])} hold the last pose elsewhere, so their errors "
+        "include how far the performer went out of view"
+        for sensor, t in board.get("sensor_tracked", {}).items()
+    ]
 
 
 def _mean_rows(rows: list[dict]) -> dict[str, float]:
@@ -165,8 +209,9 @@ def run_leaderboard(
     ``protocol``.
 
     Returns ``{"protocol", "methods": {name: {column: value}}, "per_class": {class: {name:
-    {column: value}}}, "trials", "failed_folds", "failed_methods", "skipped"}``; a method
-    that fails on a trial (``failed_methods``) leaves the other methods' rows of it.
+    {column: value}}}, "trials", "failed_folds", "failed_methods", "skipped",
+    "sensor_tracked"}`` (:func:`tracked_summary`); a method that fails on a trial
+    (``failed_methods``) leaves the other methods' rows of it.
     """
     methods = list(methods or ready_methods())
     sensors_of(methods)  # every sensor can be recorded, checked before any work
@@ -175,15 +220,16 @@ def run_leaderboard(
         raise EvaluationError(f"no class can be evaluated {protocol}: {skipped}")
     # Every device, Vive trackers included (AvatarGo's); the others read only theirs.
     setup, checks = setup or VRSetup(devices=FULL_BODY), checks or CheckConfig()
-    rows, failed, method_failures, n_trials = [], [], [], 0
+    rows, failed, method_failures, shares, n_trials = [], [], [], [], 0
     for i, fold in enumerate(all_folds):
         try:
-            fold_out, fold_failures = fold_rows(fold, setup, methods, checks, tune)
+            fold_out, fold_failures, fold_shares = fold_rows(fold, setup, methods, checks, tune)
         except SynthesisError as exc:  # e.g. no training clip passes the correlation filter
             failed.append({"class": fold.cls, "held_out": fold.held_out, "reason": str(exc)})
         else:
             rows.extend(fold_out)
             method_failures.extend(fold_failures)
+            shares.extend(fold_shares)
             n_trials += len(fold.test)
         if progress is not None:
             progress(i + 1, len(all_folds), f"{fold.cls} / {fold.held_out}")
@@ -208,6 +254,7 @@ def run_leaderboard(
         "failed_methods": method_failures,
         "skipped": skipped,
         "columns": COLUMNS,
+        "sensor_tracked": tracked_summary(shares, methods),
     }
 
 
@@ -250,6 +297,7 @@ def render_page(board: dict, plot: Path) -> str:
         + "each output on the humanoid; step latency of the streaming <code>step</code>. Means "
         + "over the trials of a class, then over classes.</p>"
         + table_html(_rows(board["methods"]), header)
+        + "".join(f"<p>{html.escape(note)}</p>" for note in tracked_notes(board))
         + image_html(plot, "Accuracy against physical plausibility, per method")
         + "<h2>Per class</h2>"
         + per_class

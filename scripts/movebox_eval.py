@@ -14,7 +14,12 @@ Azure Kinect):
 - ``jitter_m_s3``: RMS jerk of the body17 joints of the 90 Hz output, noisy input, without
   smoothing (sample-and-hold) and with it; ``truth`` for reference.
 - ``method``: the whole method (streaming clock, tracking-state rules, smoothing) scored on
-  the 90 Hz clock (:func:`scripts.method_score.score_method`), with every physics check.
+  the 90 Hz clock (:func:`scripts.method_score.score_method`), with every physics check;
+  ``err_cm`` over every tick, ``err_cm_tracked`` over the ticks that show a Kinect frame
+  tracking every body17 joint. Read them with ``tracked_frames_frac``: a performer who
+  leaves the sensor's view or range (a run across the room: CMU 09_01, 35_17, 102_01) is
+  NotTracked there, MoveBox holds the last pose where they left, and ``err_cm`` then
+  measures how far they went, not the retargeting.
 - ``loop_seam``: similarity index across the seam of the output looped naively (last frame
   to first) and trimmed (:func:`synthesis.movebox.similarity.loop_points`).
 
@@ -53,13 +58,14 @@ from render_cams.vr import VRSetup
 from scripts.method_score import score_method
 from sim.humanoid import Humanoid, humanoid_for
 from sim.thresholds import CheckConfig
-from synthesis.base import SynthesisError
+from synthesis.base import SynthesisError, on_clock
 from synthesis.movebox import MoveBox, check_stream
 from synthesis.movebox.face import AudioFormatError, lip_sync, read_wav
 from synthesis.movebox.mapping import mapping_for
 from synthesis.movebox.resize import avatar_for, resized, user_height_m
 from synthesis.movebox.retarget import ROLLS, Retargeting, twist_angle
 from synthesis.movebox.similarity import loop_points, seam_index
+from synthesis.scoring import body17_errors_cm
 
 SENSORS = ("kinect-v2", "azure-kinect")
 ACTIVITIES = ("walk", "box", "wave", "squat")
@@ -138,16 +144,30 @@ def retargeted(kinect: KinectSkeletonStream, target, roll: str) -> Motion:
     return Motion(target, float(kinect.meta["rate_hz"]), root, local)
 
 
+def shown_tracked(kinect: KinectSkeletonStream, ticks: np.ndarray) -> np.ndarray:
+    """``(B,)`` bool: the Kinect frame that each display tick ``ticks (B,)`` shows (the
+    latest at or before it, as :class:`MoveBox` shows it) tracks every body17 joint; False
+    before the first frame."""
+    shown = np.searchsorted(kinect.timestamps, ticks, side="right") - 1
+    return (shown >= 0) & body17_tracked(kinect)[np.maximum(shown, 0)]
+
+
+def mean_cm(err_m: np.ndarray, frames: np.ndarray) -> float:
+    """Mean of ``err_m (T, ...)`` over ``frames (T,)`` bool, in cm; NaN over no frame (a
+    take that the sensor never tracks whole: a swimmer, CMU 126_01)."""
+    return float(100.0 * err_m[frames].mean()) if frames.any() else float("nan")
+
+
 def body17_err_cm(output: Motion, truth: Motion, frames: np.ndarray) -> float:
     err = np.linalg.norm(body17_positions(output) - body17_positions(truth), axis=-1)
-    return float(100.0 * err[frames].mean())
+    return mean_cm(err, frames)
 
 
 def kinect_err_cm(kinect: KinectSkeletonStream, truth: Motion, frames: np.ndarray) -> float:
     """Mean error of the stream's body17 joints against the truth's."""
     idx = load_rig(kinect.rig).body17_indices()
     err = np.linalg.norm(kinect.positions[:, idx] - body17_positions(truth), axis=-1)
-    return float(100.0 * err[frames].mean())
+    return mean_cm(err, frames)
 
 
 def roll_err_deg(output: Motion, truth: Motion, frames: np.ndarray) -> float:
@@ -181,24 +201,28 @@ def evaluate_sensor(
 ) -> dict:
     """Every number of the module docstring for one take and sensor. The Kinect films the
     take on its ``humanoid`` (a real clip's rig retargeted onto the avatar body, whose rest
-    pose stands); errors are against the take itself."""
+    pose stands); errors are against the take itself, NaN over tracked frames when there
+    are none (the share says so)."""
     truth = take.truth
     on_body = (humanoid.motion, sensor)
     clean = kinect_skeleton(*on_body, seed=seed, noise=None, body=humanoid.body)
     noisy = kinect_skeleton(*on_body, seed=seed, body=humanoid.body)
     truth30 = motion_at_rate(truth, clean.meta["rate_hz"])
     tracked = body17_tracked(noisy)
-    if not tracked.any():
-        raise SynthesisError(f"{take.label}: no {sensor} frame tracks every body17 joint")
     target = avatar_for(humanoid.body.skeleton, standing_height(humanoid.motion))
-    uniform = resized_avatar(clean)
+    try:
+        uniform = resized_avatar(clean)
+    except SynthesisError:  # never a frame with the head and both feet tracked: NaN below
+        uniform = None
     row = {
         "tracked_frames_frac": float(tracked.mean()),
         "retarget_err_cm": {
             "noise_free": body17_err_cm(retargeted(clean, target, "hinge"), truth30, tracked),
             "noisy": body17_err_cm(retargeted(noisy, target, "hinge"), truth30, tracked),
             "kinect_err_cm": kinect_err_cm(noisy, truth30, tracked),
-            "resized_avatar": body17_err_cm(retargeted(clean, uniform, "hinge"), truth30, tracked),
+            "resized_avatar": float("nan")
+            if uniform is None
+            else body17_err_cm(retargeted(clean, uniform, "hinge"), truth30, tracked),
         },
     }
     if take.own_avatar:
@@ -214,7 +238,12 @@ def evaluate_sensor(
         "smoothed": rms_jerk(smoothed),
         "truth": rms_jerk(motion_at_rate(truth, smoothed.fps)),
     }
-    row["method"] = {"err_cm": result.score.err_cm, "physics": result.physics}
+    ticks = on_clock(stream).timestamps
+    row["method"] = {
+        "err_cm": result.score.err_cm,
+        "err_cm_tracked": body17_errors_cm(smoothed, truth, frames=shown_tracked(noisy, ticks)),
+        "physics": result.physics,
+    }
     search = int(LOOP_SEARCH_S * smoothed.fps)
     start, stop = loop_points(smoothed.local_rot, search)
     row["loop_seam"] = {
@@ -266,7 +295,8 @@ def run_movebox_eval(
 
 
 def summarise(rows: dict, sensors) -> dict:
-    """Means over takes per sensor, split into built-in and real takes."""
+    """Means over takes per sensor, split into built-in and real takes; a number NaN on a
+    take (no tracked frame) is averaged over the other takes."""
     out = {}
     for source in ("builtin", "real"):
         chosen = [
@@ -283,7 +313,8 @@ def _mean_tree(rows: list[dict]):
     if isinstance(first, dict):
         keys = [k for k in first if all(k in r for r in rows) and not isinstance(first[k], list)]
         return {k: _mean_tree([r[k] for r in rows]) for k in keys}
-    return float(np.mean(rows))
+    defined = [v for v in rows if np.isfinite(v)]
+    return float(np.mean(defined)) if defined else float("nan")
 
 
 def audio_files(path: Path) -> list[Path]:

@@ -53,13 +53,21 @@ GROUPS = {
 """The paper's joint groups, by body17 name."""
 
 
-def body17_errors_cm(output: Motion, truth: Motion, skip: int = WARM_UP) -> dict[str, float]:
+def body17_errors_cm(
+    output: Motion, truth: Motion, skip: int = WARM_UP, frames: np.ndarray | None = None
+) -> dict[str, float]:
     """Mean joint error in cm per group over the frames both motions have (at 90 Hz),
-    after the first ``skip``."""
+    after the first ``skip`` and, given ``frames`` (``(output.n_frames,)`` bool), only where
+    it is True (NaN when no frame is left)."""
     truth = motion_at_rate(truth, output.fps)
     n = min(output.n_frames, truth.n_frames)
     err = np.linalg.norm(body17_positions(output)[:n] - body17_positions(truth)[:n], axis=-1)
-    err = err[min(skip, n - 1) :]
+    keep = np.arange(n) >= min(skip, n - 1)
+    if frames is not None:
+        keep &= np.asarray(frames, bool)[:n]
+    if not keep.any():
+        return {g: float("nan") for g in GROUPS}
+    err = err[keep]
     per_joint = 100.0 * err.mean(axis=0)
     return {g: float(per_joint[body17.group_indices(names)].mean()) for g, names in GROUPS.items()}
 

@@ -81,10 +81,12 @@ def _board_tables(board: dict) -> list[Table]:
 
 def write_leaderboard(board: dict, out: Path, json_out: Path | None) -> None:
     """Print the leaderboard; write its JSON, plot and page into ``out``."""
-    from scripts.leaderboard import render_page, write_plot
+    from scripts.leaderboard import render_page, tracked_notes, write_plot
 
     for table in _board_tables(board):
         console.print(table)
+    for note in tracked_notes(board):
+        console.print(escape(note))
     for fail in board["failed_folds"]:
         console.print(
             "[yellow]fold failed[/] "
@@ -144,13 +146,20 @@ def write_avatargo(results: dict, out: Path, json_out: Path | None) -> None:
     console.print(f"wrote {out}/avatargo.json and avatargo.png")
 
 
-def _movebox_table(results: dict) -> Table:
-    """Means per source and sensor: Kinect joint error, retargeting (noise-free, noisy; cm),
-    roll (hinge/rest/sensor; deg), jerk (raw/smoothed; m/s^3), method error, loop seam."""
-    table = Table(title="movebox, means over takes (eval JSON: every number)")
-    for col in ("source", "sensor", "kin cm", "clean", "noisy", "roll h/r/s", "jerk", "full",
-                "seam"):  # fmt: skip
-        table.add_column(col, justify="left" if col in ("source", "sensor") else "right")
+def _movebox_tables(results: dict) -> list[Table]:
+    """Means per source and sensor, as two narrow tables (names stay whole at 80 columns).
+    Retargeting: share of Kinect frames tracking every body17 joint, Kinect joint error,
+    retargeting (noise-free, noisy; cm), roll (hinge/rest/sensor; deg). Method: jerk
+    (raw/smoothed; m/s^3), error over every tick and over tracked ticks (cm), loop seam."""
+    columns = {
+        "retargeting": ("tracked", "kinect cm", "clean", "noisy", "roll h/r/s"),
+        "method": ("jerk", "full cm", "tracked cm", "seam"),
+    }
+    tables = {}
+    for name, cols in columns.items():
+        tables[name] = Table(title=f"movebox {name}, means over takes (eval JSON: all)")
+        for col in ("source", "sensor", *cols):
+            tables[name].add_column(col, justify="left" if col in ("source", "sensor") else "right")
     for source, sensors in results["summary"].items():
         for sensor, s in sensors.items():
             r, roll, jerk = s["retarget_err_cm"], s.get("roll_err_deg"), s["jitter_m_s3"]
@@ -159,18 +168,24 @@ def _movebox_table(results: dict) -> Table:
                 if roll is None
                 else "/".join(f"{roll[k]:.0f}" for k in ("hinge", "rest", "sensor"))
             )
-            table.add_row(
+            tables["retargeting"].add_row(
                 source,
                 sensor,
+                f"{s['tracked_frames_frac']:.0%}",
                 f"{r['kinect_err_cm']:.1f}",
                 f"{r['noise_free']:.2f}",
                 f"{r['noisy']:.1f}",
                 rolls,
+            )
+            tables["method"].add_row(
+                source,
+                sensor,
                 f"{jerk['unsmoothed'] / 1e3:.0f}k/{jerk['smoothed'] / 1e3:.0f}k",
                 f"{s['method']['err_cm']['full']:.1f}",
+                f"{s['method']['err_cm_tracked']['full']:.1f}",
                 f"{s['loop_seam']['naive']:.1f}/{s['loop_seam']['trimmed']:.1f}",
             )
-    return table
+    return list(tables.values())
 
 
 def run_movebox(library, out, wanted, per_source, duration, quick, audio, kinect, seed, json_out):
@@ -214,7 +229,8 @@ def run_movebox(library, out, wanted, per_source, duration, quick, audio, kinect
             ),
         )
     results.update(library=library, quick=quick)
-    console.print(_movebox_table(results))
+    for table in _movebox_tables(results):
+        console.print(table)
     for name, row in results.get("lip_sync", {}).items():
         console.print(f"lip sync {escape(name)}: jaw vs RMS envelope r = {row['r_jaw_rms']:.3f}")
     results["story"] = write_story(out / "story", 2.0 if quick else 4.0, seed, (files or [None])[0])

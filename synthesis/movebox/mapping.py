@@ -9,6 +9,15 @@ that *ends* there (a swing with no roll, paper §IV-A1); Azure Kinect the rotati
 that *starts* there. The pelvis is set by its triad (spine base and both hips), which fixes
 its heading on both sensors (V2's root orientation has none).
 
+Spine and neck bones aim at their Kinect joints scaled about the Kinect root to the avatar's
+torso (``torso``; :meth:`~synthesis.movebox.retarget.Retargeting.torso_scaled`): a
+height-resized avatar's torso is not the user's length (pelvis to neck 38 cm on the avatar
+resized to a CMU subject whose own is 24 cm), and a spine bone aimed from the avatar's start
+at a Kinect joint that start has already passed folds down (the 9 CMU clips, noise-free:
+Spine2 up to 118 degrees off the subject's own pelvis-neck line). Limbs and clavicles aim at
+the joints themselves, so that the avatar's hands land on the user's whatever the arm
+lengths.
+
 Avatar bones without a drive (fingers, toes, jaw, eyelids, V2's head, stabilised wrists)
 keep their rest rotation relative to their parent.
 """
@@ -32,6 +41,7 @@ class BoneDrive:
         orient_rest: the Kinect rest bone (from, to) that ``orient``'s orientation turns.
         bend: for a bone whose child is a hinge (elbow, knee), the direction the child's far
             end moves when the hinge flexes, in this bone's rest frame; else None.
+        torso: aim at ``aim`` scaled to the avatar's torso (spine and neck bones).
     """
 
     joint: str
@@ -40,6 +50,7 @@ class BoneDrive:
     orient: str
     orient_rest: tuple[str, str]
     bend: tuple[float, float, float] | None = None
+    torso: bool = False
 
     @property
     def kinect_joints(self) -> tuple[str, ...]:
@@ -54,6 +65,7 @@ class RigMapping:
     Attributes:
         rig: ``"kinect_v2"`` or ``"azure_kinect"``.
         root: the Kinect joint at the avatar's pelvis (root position).
+        neck: the Kinect joint at the avatar's neck (the top of the torso).
         hips: the Kinect (left, right) hip joints of the pelvis triad.
         drives: the driven bones, parents before children.
         hands: the avatar hand joints (wrist stabilisation, §IV-B2).
@@ -61,14 +73,21 @@ class RigMapping:
 
     rig: str
     root: str
+    neck: str
     hips: tuple[str, str]
     drives: tuple[BoneDrive, ...]
     hands: tuple[str, str] = ("Bip01 L Hand", "Bip01 R Hand")
 
 
 PELVIS = "Bip01 Pelvis"
+NECK = "Bip01 Neck"
 PELVIS_TRIAD = ("Bip01 L Thigh", "Bip01 R Thigh")
-"""The avatar's pelvis joint and the hip joints that fix its rotation with it."""
+"""The avatar's pelvis and neck joints (its torso), and the hip joints that fix the pelvis'
+rotation with it."""
+
+
+def _torso(drive: BoneDrive) -> BoneDrive:
+    return replace(drive, torso=True)
 
 
 def _v2_drive(joint: str, child: str, start: str, end: str) -> BoneDrive:
@@ -119,12 +138,13 @@ def _azure_side(side: str) -> dict[str, str]:
 KINECT_V2 = RigMapping(
     rig="kinect_v2",
     root="SpineBase",
+    neck="Neck",
     hips=("HipLeft", "HipRight"),
     drives=(
-        _v2_drive("Bip01 Spine", "Bip01 Spine1", "SpineBase", "SpineMid"),
-        _v2_drive("Bip01 Spine1", "Bip01 Spine2", "SpineMid", "SpineShoulder"),
-        _v2_drive("Bip01 Spine2", "Bip01 Neck", "SpineShoulder", "Neck"),
-        _v2_drive("Bip01 Neck", "Bip01 Head", "Neck", "Head"),
+        _torso(_v2_drive("Bip01 Spine", "Bip01 Spine1", "SpineBase", "SpineMid")),
+        _torso(_v2_drive("Bip01 Spine1", "Bip01 Spine2", "SpineMid", "SpineShoulder")),
+        _torso(_v2_drive("Bip01 Spine2", "Bip01 Neck", "SpineShoulder", "Neck")),
+        _torso(_v2_drive("Bip01 Neck", "Bip01 Head", "Neck", "Head")),
         *_limbs("L", _v2_side("L"), _v2_drive),
         *_limbs("R", _v2_side("R"), _v2_drive),
     ),
@@ -138,12 +158,20 @@ def _azure_limb_drive(joint: str, child: str, start: str, end: str) -> BoneDrive
 AZURE_KINECT = RigMapping(
     rig="azure_kinect",
     root="PELVIS",
+    neck="NECK",
     hips=("HIP_LEFT", "HIP_RIGHT"),
     drives=(
-        _azure_drive("Bip01 Spine", "Bip01 Spine1", "SPINE_NAVAL", "SPINE_NAVAL", "SPINE_CHEST"),
-        _azure_drive("Bip01 Spine1", "Bip01 Spine2", "SPINE_CHEST", "SPINE_CHEST", "NECK"),
-        _azure_drive("Bip01 Spine2", "Bip01 Neck", "SPINE_CHEST", "NECK", "NECK"),
-        _azure_drive("Bip01 Neck", "Bip01 Head", "NECK", "HEAD", "HEAD"),
+        *map(
+            _torso,
+            (
+                _azure_drive(
+                    "Bip01 Spine", "Bip01 Spine1", "SPINE_NAVAL", "SPINE_NAVAL", "SPINE_CHEST"
+                ),
+                _azure_drive("Bip01 Spine1", "Bip01 Spine2", "SPINE_CHEST", "SPINE_CHEST", "NECK"),
+                _azure_drive("Bip01 Spine2", "Bip01 Neck", "SPINE_CHEST", "NECK", "NECK"),
+                _azure_drive("Bip01 Neck", "Bip01 Head", "NECK", "HEAD", "HEAD"),
+            ),
+        ),
         # The head's roll and nod: Azure's HEAD orientation turns the neck-head bone.
         BoneDrive("Bip01 Head", "Bip01 HeadNub", None, "HEAD", ("NECK", "HEAD")),
         *_limbs("L", _azure_side("L"), _azure_limb_drive),

@@ -18,7 +18,10 @@ q_absolute), gives it back. The absolute rotation of a bone:
    the hinge (the roll is then seen, not assumed, wherever the joint is bent).
 2. its direction: the smallest rotation that turns the bone (from where its parents put its
    start) towards the Kinect joint it aims at, so the avatar's limbs point where the
-   user's do whatever the rig proportions.
+   user's do whatever the rig proportions; spine and neck bones aim at their Kinect joints
+   scaled to the avatar's torso (:meth:`Retargeting.torso_scaled`), so that an avatar torso
+   longer than the user's stays straight instead of folding back towards Kinect joints it
+   has passed (:mod:`.mapping`).
 
 Unmapped joints keep their rest rotation relative to their parent. Wrist stabilisation
 (§IV-B2: "fix the wrist rotations and set them to match that of the lower arm") leaves the
@@ -29,12 +32,13 @@ Kinect's (spine base to each hip).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
 from avatar_models import Skeleton, quat
 from synthesis.base import SynthesisError
-from synthesis.movebox.mapping import PELVIS, PELVIS_TRIAD, BoneDrive, RigMapping
+from synthesis.movebox.mapping import NECK, PELVIS, PELVIS_TRIAD, BoneDrive, RigMapping
 
 ROLLS = ("hinge", "rest", "sensor")
 BEND_FADE = (0.1, 0.3)
@@ -135,6 +139,23 @@ class Retargeting:
             self.kinect_rest[b] - self.kinect_rest[a],
         )
 
+    @cached_property
+    def torso_m(self) -> float:
+        """The avatar's rest pelvis-to-neck distance."""
+        rest = self.target.rest_positions()
+        return float(
+            np.linalg.norm(rest[self.target.index(NECK)] - rest[self.target.index(PELVIS)])
+        )
+
+    def torso_scaled(self, positions: np.ndarray) -> np.ndarray:
+        """``(N, K, 3)`` Kinect ``positions (N, K, 3)`` scaled about the Kinect root, per
+        frame, so that root-to-neck is the avatar's :attr:`torso_m`: where the spine and neck
+        bones aim (the user's torso directions on the avatar's torso length)."""
+        root = positions[:, [self.kinect_index(self.mapping.root)]]
+        neck = positions[:, [self.kinect_index(self.mapping.neck)]]
+        user = np.linalg.norm(neck - root, axis=-1, keepdims=True)
+        return root + (positions - root) * (self.torso_m / np.maximum(user, 1e-6))
+
     def check_chains(self) -> None:
         """Every driven joint's ancestors are driven or the root (what ``__call__`` needs).
 
@@ -152,8 +173,10 @@ class Retargeting:
         out: list[tuple[int, ...]] = [()] * self.target.n_joints
         triad = (self.mapping.root, *self.mapping.hips)
         out[self.target.index(PELVIS)] = tuple(self.kinect_index(n) for n in triad)
+        torso = (self.mapping.root, self.mapping.neck)  # the torso scale reads them too
         for d in self.drives():
-            out[self.target.index(d.joint)] = tuple(self.kinect_index(n) for n in d.kinect_joints)
+            names = dict.fromkeys((*d.kinect_joints, *(torso if d.torso else ())))
+            out[self.target.index(d.joint)] = tuple(self.kinect_index(n) for n in names)
         return out
 
     def __call__(
@@ -170,6 +193,7 @@ class Retargeting:
         pelvis = sk.index(PELVIS)
         driven = sorted({*drives, pelvis})
         local = np.tile(quat.IDENTITY, (n, sk.n_joints, 1))
+        torso = self.torso_scaled(positions)
         # Undriven joints keep their rest local rotation, so only the driven ones (and their
         # ancestors, all driven or the root) need an absolute rotation and a position.
         for j in driven:
@@ -178,9 +202,8 @@ class Retargeting:
             if j == pelvis:
                 world[:, j] = self._pelvis(positions)
             else:
-                world[:, j] = self._bone(
-                    drives[j], world[:, parent], pos[:, j], positions, orientations
-                )
+                aims = torso if drives[j].torso else positions
+                world[:, j] = self._bone(drives[j], world[:, parent], pos[:, j], aims, orientations)
             local[:, j] = quat.mul(quat.conj(world[:, parent]), world[:, j])
         return pos[:, 0], local
 
@@ -196,7 +219,8 @@ class Retargeting:
         return quat.from_matrix(now @ then.T)
 
     def _bone(self, drive, parent_world, start, positions, orientations) -> np.ndarray:
-        """``(N, 4)`` absolute rotation of one driven bone (module docstring)."""
+        """``(N, 4)`` absolute rotation of one driven bone (module docstring) aiming at
+        Kinect ``positions (N, K, 3)`` (torso-scaled for spine and neck bones)."""
         if self.roll == "sensor":
             sensor = orientations[:, self.kinect_index(drive.orient)]
             world = quat.mul(sensor, self.rest_alignment(drive))

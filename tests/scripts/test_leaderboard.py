@@ -11,7 +11,7 @@ from typer.testing import CliRunner
 
 from avatar_models.formats import load_motion
 from scripts.cli import app
-from scripts.leaderboard import COLUMNS, run_leaderboard
+from scripts.leaderboard import COLUMNS, run_leaderboard, tracked_notes, tracked_summary
 from synthesis.evaluate import Trial
 from synthesis.methods import METHODS, ready_methods
 from tests.conftest import require
@@ -43,6 +43,19 @@ def test_leaderboard_on_a_small_builtin_set(tmp_path):
     }
     page = (out / "leaderboard.html").read_text()
     assert "coolmoves+arm-ik" in page and "data:image/png;base64" in page
+    kinect = board["sensor_tracked"]["kinect"]
+    assert "movebox" in kinect["methods"] and 0.0 <= kinect["mean"] <= 1.0
+    assert "kinect: every body17 joint tracked in" in page
+
+
+def test_tracked_share_is_averaged_per_class_then_over_classes():
+    shares = [("run", "kinect", 0.2), ("run", "kinect", 0.4), ("wave", "kinect", 1.0)]
+    summary = tracked_summary(shares, ["ik", "movebox"])
+    assert summary["kinect"]["per_class"] == pytest.approx({"run": 0.3, "wave": 1.0})
+    assert summary["kinect"]["mean"] == pytest.approx(0.65)
+    assert summary["kinect"]["methods"] == ["movebox"]
+    (note,) = tracked_notes({"sensor_tracked": summary})
+    assert note.startswith("kinect: every body17 joint tracked in 65% of frames (run 30%")
 
 
 REAL_PAIRS = {

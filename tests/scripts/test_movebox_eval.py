@@ -8,12 +8,15 @@ from dataclasses import replace
 from pathlib import Path
 
 import mujoco
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
 from avatar_models.generator import generate
-from render_cams.kinect import kinect_skeleton
+from avatar_models.rigs import load_rig
+from render_cams.kinect import TrackingState, kinect_skeleton
 from scripts.cli import app
+from scripts.movebox_eval import mean_cm, shown_tracked, summarise
 from tests.synthesis.movebox.conftest import AUDIO_DIR
 
 runner = CliRunner()
@@ -62,6 +65,25 @@ def test_builtin_numbers_story_and_recorded_take(tmp_path, recorded_stream):
     assert {Path(f).suffix for f in payload["take"]["files"]} == {".npz", ".bvh"}
 
 
+def test_shown_tracked_is_the_latest_kinect_frame_at_or_before_each_tick(recorded_stream):
+    rig = load_rig(recorded_stream.rig)
+    states = np.full_like(recorded_stream.states, TrackingState.TRACKED)
+    states[1, rig.body17_indices()[5]] = TrackingState.INFERRED  # frame 1: a wrist guessed
+    stream = replace(recorded_stream, states=states)
+    frame = 1.0 / 30.0
+    ticks = np.array([-0.01, 0.0, 0.5, 1.0, 1.5, 2.0, 2.5]) * frame + stream.timestamps[0]
+    shown = shown_tracked(stream, ticks)
+    assert shown.tolist() == [False, True, True, False, False, True, True]
+
+
+def test_a_take_never_tracked_whole_has_nan_tracked_errors_left_out_of_the_means():
+    err = np.full((4, 17), 0.02)
+    assert mean_cm(err, np.ones(4, bool)) == pytest.approx(2.0)
+    assert np.isnan(mean_cm(err, np.zeros(4, bool)))
+    rows = {"a": {"s": {"e": 2.0}}, "b": {"s": {"e": float("nan")}}, "c": {"s": {"e": 4.0}}}
+    assert summarise(rows, ["s"])["real"]["s"]["e"] == pytest.approx(3.0)
+
+
 @pytest.mark.mocap
 def test_real_clip_of_each_source(tmp_path, mocap_dir):
     out, js = tmp_path / "out", tmp_path / "r.json"
@@ -77,6 +99,13 @@ def test_real_clip_of_each_source(tmp_path, mocap_dir):
     for row in payload["takes"].values():
         for sensor in ("kinect-v2", "azure-kinect"):
             assert row[sensor]["method"]["err_cm"]["full"] < 30.0
+            assert 0.0 <= row[sensor]["tracked_frames_frac"] <= 1.0
+            assert set(row[sensor]["method"]["err_cm_tracked"]) == {
+                "hands",
+                "upper",
+                "lower",
+                "full",
+            }
 
 
 @pytest.mark.parametrize("case", ["audio", "empty", "never-tracked", "not-a-recording"])

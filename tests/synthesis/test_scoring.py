@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from avatar_models import Motion
 from avatar_models.generator import Subject, generate
 from render_cams import VRSetup
 from synthesis.base import SynthesisError
@@ -20,6 +21,19 @@ def test_errors_by_group_on_a_known_offset():
     moved = truth.translated(np.array([0.0, 0.03, 0.04]))
     err = body17_errors_cm(moved, truth, skip=0)
     assert err == pytest.approx({"hands": 5.0, "upper": 5.0, "lower": 5.0, "full": 5.0})
+
+
+def test_errors_only_over_the_frames_asked_for():
+    """The second half shifted by 5 cm, the first exact: 5 cm over the second half alone,
+    NaN over no frame."""
+    truth = generate("box", Subject(), 0.5, 90.0, seed=1)
+    half = truth.n_frames // 2
+    second = truth.translated(np.array([0.0, 0.03, 0.04]))
+    root = np.concatenate([truth.root_pos[:half], second.root_pos[half:]])
+    output = Motion(truth.skeleton, truth.fps, root, truth.local_rot)
+    late = np.arange(truth.n_frames) >= half
+    assert body17_errors_cm(output, truth, frames=late)["full"] == pytest.approx(5.0)
+    assert np.isnan(body17_errors_cm(output, truth, frames=np.zeros_like(late))["full"])
 
 
 def test_a_perfect_method_scores_zero_error_and_full_correlation(test_motion):
