@@ -7,7 +7,11 @@ tick uses only the Kinect frames stamped at or before it. Per new Kinect frame:
 wrist stabilisation), then :class:`~synthesis.movebox.confidence.ConfidenceFilter`
 (NotTracked held, Inferred blended, never-seen at rest); per display tick: the latest
 frame, its absolute rotations smoothed (:mod:`.smoothing`), which also carries 30 Hz onto
-90 Hz.
+90 Hz. The paper smooths the rotations only ("the rotations between frames are interpolated
+using exponential smoothing", §III-A1), so the root position steps with each Kinect frame;
+smoothing it as well (``smooth_root``) goes beyond the paper: it removes the 30 Hz steps
+(jerk) at the price of lag, ~5-9 cm behind a runner at 2.6-3.6 m/s
+(``tests/measurements/movebox_error_sources.py``).
 
 Shapes: ``B`` ticks, ``N`` Kinect frames, ``K`` Kinect joints, ``J`` avatar joints.
 """
@@ -60,6 +64,7 @@ class MoveBox(Synthesizer):
         roll: ``"hinge"``, ``"rest"``, ``"sensor"`` or ``"auto"`` (:data:`DEFAULT_ROLL`).
         stabilise_wrists: hands follow the forearm (§IV-B2).
         tau_s: smoothing time constant (0: none).
+        smooth_root: also smooth the root position (beyond the paper, see above).
 
     Raises:
         SynthesisError: an unusable stream (:func:`check_stream`), an unknown Kinect rig
@@ -76,6 +81,7 @@ class MoveBox(Synthesizer):
         roll: str = "auto",
         stabilise_wrists: bool = True,
         tau_s: float = TIME_CONSTANT_S,
+        smooth_root: bool = False,
     ) -> None:
         check_stream(kinect)
         mapping = mapping_for(kinect.rig)
@@ -97,6 +103,7 @@ class MoveBox(Synthesizer):
         self._sources = self.retargeting.joint_sources()
         self._root_joint = kinect.joint_names.index(mapping.root)
         self.tau_s = float(tau_s)
+        self.smooth_root = bool(smooth_root)
         self.reset()
 
     @property
@@ -109,6 +116,7 @@ class MoveBox(Synthesizer):
             "roll": self.retargeting.roll,
             "stabilise_wrists": self.retargeting.stabilise_wrists,
             "tau_s": self.tau_s,
+            "smooth_root": self.smooth_root,
         }
 
     def reset_state(self) -> None:
@@ -157,7 +165,9 @@ class MoveBox(Synthesizer):
             self._last_root, self._last_rot = root[-1:], local[-1:]
         parents = self.skeleton.parents
         world = self._smoother("rot", absolute(rots, parents), True)
-        return Poses(self._smoother("root", roots, False), relative(world, parents))
+        if self.smooth_root:
+            roots = self._smoother("root", roots, False)
+        return Poses(roots, relative(world, parents))
 
     def record(self, rate_hz: float = DEFAULT_RATE_HZ) -> Motion:
         """The whole Kinect stream as an animation (MoveBox's recording, §III-B1): a fresh

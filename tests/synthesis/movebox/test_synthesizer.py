@@ -84,3 +84,21 @@ def test_registry_drives_a_resized_avatar_for_a_foreign_rig(noisy_kinect):
     synth = build("movebox", inputs)
     assert synth.name == "movebox" and synth.skeleton.name == "avatar"
     assert standing_height(synth.skeleton) == pytest.approx(1.62)
+
+
+def test_root_steps_with_kinect_frames_unless_smoothed(noisy_kinect, box_truth, vr_stream):
+    """The paper smooths rotations only (§III-A1): at 90 Hz each 30 Hz Kinect frame's root is
+    shown unchanged on about three ticks; ``smooth_root`` (beyond the paper) moves it every
+    tick."""
+    kinect = noisy_kinect["kinect-v2"]
+    shown = vr_stream.timestamps > kinect.timestamps[0]
+    n_frames = np.count_nonzero(kinect.timestamps <= vr_stream.timestamps[-1])
+    paper = MoveBox(kinect, box_truth.skeleton).run(vr_stream).root_pos[shown]
+    smooth = MoveBox(kinect, box_truth.skeleton, smooth_root=True).run(vr_stream).root_pos[shown]
+    assert root_changes(paper) <= n_frames
+    assert root_changes(smooth) > 2 * n_frames
+
+
+def root_changes(root: np.ndarray) -> int:
+    """Ticks whose root ``(T, 3)`` differs from the tick before."""
+    return int(np.count_nonzero(np.any(np.diff(root, axis=0) != 0, axis=1)))
