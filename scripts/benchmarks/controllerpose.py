@@ -22,25 +22,13 @@ from scripts.benchmarks import BenchRow, best_of
 from scripts.controllerpose.recording import keypoint_recording
 from sim.humanoid import humanoid_for
 from synthesis.base import FrameBatch, on_clock
-from synthesis.controllerpose.checkpoint import Checkpoint
+from synthesis.controllerpose.checkpoint import untrained
 from synthesis.controllerpose.examples import VRStream, frame_features
 from synthesis.controllerpose.fk import forward_kinematics
-from synthesis.controllerpose.network import LiftingNet, NetConfig
-from synthesis.controllerpose.normaliser import Normaliser
 from synthesis.controllerpose.synthesizer import ControllerPose
 
 PAPER_MS = {"pose_estimation": 128.0, "compositing": 63.0, "unity_ik": 17.0, "total": 297.0}
 PAPER_FPS = 7.2
-
-
-def untrained_checkpoint(positions: np.ndarray, height: float) -> Checkpoint:
-    torch.manual_seed(0)
-    net = NetConfig()
-    _, lengths = angles_from_positions(positions)
-    ones, zeros = np.ones((4, 289), np.float32), np.zeros((4, 289), np.float32)
-    normaliser = Normaliser(zeros, ones, np.zeros(15, np.float32), np.ones(15, np.float32))
-    weights = LiftingNet(net).state_dict()
-    return Checkpoint(net, weights, normaliser, lengths.mean(0) / height, {}, "", 0, [], {})
 
 
 def run(quick: bool = False) -> list[BenchRow]:
@@ -59,7 +47,8 @@ def run(quick: bool = False) -> list[BenchRow]:
     features_s = best_of(
         lambda: frame_features(recording.uv, recording.conf, recording.time, vr), 3
     )
-    checkpoint = untrained_checkpoint(body17_positions(humanoid.motion), height)
+    _, lengths = angles_from_positions(body17_positions(humanoid.motion))
+    checkpoint = untrained(lengths.mean(0) / height)
     model = checkpoint.model()
     features, _, _ = frame_features(recording.uv, recording.conf, recording.time, vr)
     inputs = [torch.from_numpy(a) for a in (features.skeletons, features.found, features.vr)]

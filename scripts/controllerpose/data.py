@@ -13,6 +13,7 @@ it existed lack it).
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -48,6 +49,12 @@ def sample_height(sample: dict, body17: np.ndarray) -> float:
     return float(body17[:, 0, 2].max() - body17[:, [12, 16], 2].min())
 
 
+def split_samples(root: Path, split: str) -> Iterator[tuple[int, dict]]:
+    """The samples of ``split`` of dataset ``root`` in shard order, each with its group
+    number (the ``group`` of its examples in :func:`load_examples`)."""
+    return enumerate(ShardDataset(root, split=split))
+
+
 def load_examples(root: str | Path, split: str, frame_stride: int = 1) -> Examples:
     """The examples of ``split`` of dataset folder ``root``, every ``frame_stride``-th camera
     frame of each sample (consecutive 30 Hz frames are near duplicates; the paper's study
@@ -59,9 +66,8 @@ def load_examples(root: str | Path, split: str, frame_stride: int = 1) -> Exampl
             ``fisheye = true`` and ``vr = true``).
     """
     root = Path(root)
-    dataset = ShardDataset(root, split=split)
     parts = []
-    for group, sample in enumerate(dataset):
+    for group, sample in split_samples(root, split):
         missing = [k for k in NEEDED if k not in sample]
         if missing:
             raise DatasetError(

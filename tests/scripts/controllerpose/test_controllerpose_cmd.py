@@ -102,3 +102,16 @@ def test_an_occupied_out_that_holds_no_run_exits_2(cp_dataset, tmp_path):
     assert sorted(p.name for p in occupied.iterdir()) == ["notes.txt"]
     result = runner.invoke(app, [*args, "--out", str(occupied / "notes.txt")])
     assert result.exit_code == 2 and "is a file" in result.output
+
+
+def test_the_shipped_scenario_without_a_model_exits_2_before_any_stage(tmp_path, monkeypatch):
+    from pathlib import Path
+
+    from synthesis.controllerpose.synthesizer import MODEL_ENV
+
+    scenario = Path(__file__).resolve().parents[3] / "scripts/scenarios/methods/controllerpose.toml"
+    monkeypatch.setenv(MODEL_ENV, str(tmp_path / "no-model"))
+    result = runner.invoke(app, ["run", str(scenario), "--out", str(tmp_path / "run")])
+    assert result.exit_code == 2
+    assert "no trained model" in result.output and "train controllerpose" in result.output
+    assert not (tmp_path / "run").exists()
