@@ -46,9 +46,12 @@ def test_eval_reports_model_baseline_and_ablation(cp_run, cp_dataset, tmp_path):
     )  # fmt: skip
     assert result.exit_code == 0, result.output
     report = json.loads((tmp_path / "eval" / "eval.json").read_text())
-    assert set(report["results"]) == {"controllerpose", "nearest-neighbour", "controllerpose-no-vr"}
-    full = report["results"]["controllerpose"]
-    assert np.isfinite(full["mean_cm"]) and full["per_joint_cm"]["pelvis"] < 1e-6
+    methods = {"controllerpose", "nearest-neighbour", "controllerpose-no-vr", "coolmoves"}
+    assert set(report["results"]) == methods
+    for name in methods:  # the same frames, §5.3-normalised: the pelvis is the origin
+        res = report["results"][name]
+        assert res["frames"] == report["results"]["controllerpose"]["frames"]
+        assert np.isfinite(res["mean_cm"]) and res["per_joint_cm"]["pelvis"] < 1e-6
 
 
 def test_a_dataset_without_keypoints_exits_2(tmp_path):
