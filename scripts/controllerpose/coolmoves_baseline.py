@@ -4,11 +4,11 @@ The registry's ``coolmoves`` (CoolMoves §3.1 as the paper describes it: headset
 controllers, no cameras) with a database of the dataset's *training split* only: the motions
 the train samples were recorded from, regenerated from the dataset's plan
 (:func:`scripts.dataset.motion_source.window_motion`: the same subjects, activities and
-window seeds). Each evaluated sample's recorded VR stream (``vr_*``) drives it at the user's
-height; its body17 keypoints are read at the same camera frames as the examples (the newest
-90 Hz tick at or before each frame, so it never sees a later VR sample than ControllerPose
-does), then normalised by :func:`synthesis.controllerpose.evaluate.normalise` like every
-other row of the table.
+window seeds). Each evaluated recording's VR stream (a sample's ``vr_*``, or a real clip's
+as the simulated devices record it) drives it at the user's height; its body17 keypoints
+are read at the same camera frames as the examples (the newest 90 Hz tick at or before each
+frame, so it never sees a later VR sample than ControllerPose does), then normalised by
+:func:`synthesis.controllerpose.evaluate.normalise` like every other row of the table.
 """
 
 from __future__ import annotations
@@ -20,7 +20,6 @@ import numpy as np
 from avatar_models.motion import Motion
 from avatar_models.rigs import body17_positions
 from render_cams import TrackingStream
-from scripts.controllerpose.data import sample_height, split_samples
 from scripts.dataset.config import from_dict
 from scripts.dataset.manifest import read_manifest
 from scripts.dataset.motion_source import window_motion
@@ -40,26 +39,13 @@ def training_motions(root: Path) -> list[Motion]:
 
 
 def coolmoves_positions(
-    database: Database, root: Path, split: str, examples: Examples
+    database: Database, streams: dict[int, tuple[TrackingStream, float]], examples: Examples
 ) -> np.ndarray:
-    """World body17 keypoints ``(N, 17, 3)`` of CoolMoves at each of ``examples`` (those
-    of :func:`scripts.controllerpose.data.load_examples` on the same ``root`` and
-    ``split``), driven by its sample's VR stream."""
+    """World body17 keypoints ``(N, 17, 3)`` of CoolMoves at each of ``examples``, driven by
+    ``streams[group]`` (its recording's VR stream and the user's height)."""
     out = np.zeros(examples.positions.shape, dtype=np.float64)
-    wanted = set(np.unique(examples.group).tolist())
-    for group, sample in split_samples(root, split):
-        if group not in wanted:
-            continue
-        meta = sample["json"]
-        stream = TrackingStream(
-            tuple(meta["channels"]["vr"]["devices"]),
-            sample["vr_time"].numpy(),
-            sample["vr_pos"].numpy(),
-            sample["vr_quat"].numpy(),
-            sample["vr_valid"].numpy(),
-            meta={"rate_hz": float(meta["channels"]["vr"]["rate_hz"])},
-        )
-        height = sample_height(sample, sample["body17"].numpy())
+    for group in np.unique(examples.group):
+        stream, height = streams[int(group)]
         synth = METHODS[METHOD].build(MethodInputs(lambda: database, height, database.skeleton))
         motion = synth.run(stream)
         rows = np.flatnonzero(examples.group == group)

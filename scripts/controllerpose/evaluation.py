@@ -23,7 +23,7 @@ from avatar_models.body17 import BODY17
 from avatar_models.errors import AvatarsimError
 from avatar_models.fileio import write_json
 from scripts.controllerpose.coolmoves_baseline import coolmoves_positions, training_motions
-from scripts.controllerpose.data import load_examples, mocap_examples
+from scripts.controllerpose.data import load_examples, mocap_examples, split_streams
 from scripts.controllerpose.figures import plt, save_png
 from synthesis.controllerpose.checkpoint import Checkpoint, load
 from synthesis.controllerpose.evaluate import (
@@ -108,17 +108,19 @@ def run_evaluation(
         ablation_checkpoint,
         test,
         train,
-        coolmoves_positions(database, data, "test", test),
+        coolmoves_positions(database, split_streams(data, "test"), test),
     )
     real = None
     if mocap is not None:
-        clips = mocap_examples(mocap, mocap_clips, MOCAP_SECONDS)
+        clips, streams = mocap_examples(mocap, mocap_clips, MOCAP_SECONDS)
         clips.features.check_finite(f"{mocap} clips")
+        clips = clips.take(np.arange(0, len(clips), frame_stride))
         real = split_results(
             checkpoint,
             ablation_checkpoint,
-            clips.take(np.arange(0, len(clips), frame_stride)),
+            clips,
             train,
+            coolmoves_positions(database, streams, clips),
         )
     full = results["controllerpose"]["mean_cm"]
     report = {
