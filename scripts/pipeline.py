@@ -70,11 +70,22 @@ def validate(scenario: Scenario) -> None:
         raise ScenarioError(f"[physics]: {exc}") from exc
 
 
+def check_ready(scenario: Scenario) -> None:
+    """Refuses, before any stage runs, a scenario whose methods cannot be built yet (e.g.
+    ``controllerpose`` without a trained model), saying what to do. Apart from
+    :func:`validate`: a scenario file is valid before its model is trained."""
+    methods = scenario.synthesis.methods if scenario.synthesis is not None else ()
+    missing = [f"{m}: {why}" for m in methods if (why := METHODS[m].missing()) is not None]
+    if missing:
+        raise ScenarioError(f"{scenario.name} cannot run yet: {'; '.join(missing)}")
+
+
 def run_scenario(
     scenario: Scenario, out_dir: Path, console: Console | None = None
 ) -> dict[str, Any]:
     """Run every stage, evaluate thresholds, write results.json and junit.xml into ``out_dir``."""
     validate(scenario)
+    check_ready(scenario)
     console = console or Console(stderr=True)
     with atomic_dir(out_dir, "run") as partial:
         return _run_stages(scenario, partial, console)

@@ -13,11 +13,13 @@ it existed lack it).
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
 
 from avatar_models.rigs import body17_positions
+from render_cams import TrackingStream
 from scripts.dataset.manifest import MANIFEST_FILE, DatasetError, read_manifest
 from scripts.dataset.torch_dataset import ShardDataset
 from synthesis.controllerpose.examples import Examples, VRStream, concat, recording_examples
@@ -48,6 +50,12 @@ def sample_height(sample: dict, body17: np.ndarray) -> float:
     return float(body17[:, 0, 2].max() - body17[:, [12, 16], 2].min())
 
 
+def split_samples(root: Path, split: str) -> Iterator[tuple[int, dict]]:
+    """The samples of ``split`` of dataset ``root`` in shard order, each with its group
+    number (the ``group`` of its examples in :func:`load_examples`)."""
+    return enumerate(ShardDataset(root, split=split))
+
+
 def load_examples(root: str | Path, split: str, frame_stride: int = 1) -> Examples:
     """The examples of ``split`` of dataset folder ``root``, every ``frame_stride``-th camera
     frame of each sample (consecutive 30 Hz frames are near duplicates; the paper's study
@@ -59,9 +67,8 @@ def load_examples(root: str | Path, split: str, frame_stride: int = 1) -> Exampl
             ``fisheye = true`` and ``vr = true``).
     """
     root = Path(root)
-    dataset = ShardDataset(root, split=split)
     parts = []
-    for group, sample in enumerate(dataset):
+    for group, sample in split_samples(root, split):
         missing = [k for k in NEEDED if k not in sample]
         if missing:
             raise DatasetError(
@@ -101,11 +108,33 @@ def load_examples(root: str | Path, split: str, frame_stride: int = 1) -> Exampl
     return concat(parts)
 
 
-def mocap_examples(folder: Path, clips: int, seconds: float, seed: int = 0) -> Examples:
+def sample_stream(sample: dict) -> tuple[TrackingStream, float]:
+    """A dataset sample's recorded VR stream and its subject's standing height."""
+    meta = sample["json"]
+    stream = TrackingStream(
+        tuple(meta["channels"]["vr"]["devices"]),
+        sample["vr_time"].numpy(),
+        sample["vr_pos"].numpy(),
+        sample["vr_quat"].numpy(),
+        sample["vr_valid"].numpy(),
+        meta={"rate_hz": float(meta["channels"]["vr"]["rate_hz"])},
+    )
+    return stream, sample_height(sample, sample["body17"].numpy())
+
+
+def split_streams(root: Path, split: str) -> dict[int, tuple[TrackingStream, float]]:
+    """Per group of :func:`load_examples` on ``split``: its VR stream and the subject's
+    height (:func:`sample_stream`)."""
+    return {group: sample_stream(sample) for group, sample in split_samples(root, split)}
+
+
+def mocap_examples(
+    folder: Path, clips: int, seconds: float, seed: int = 0
+) -> tuple[Examples, dict[int, tuple[TrackingStream, float]]]:
     """Held-out real mocap as examples: ``clips`` BVH files spread evenly over ``folder``'s
     (sorted) tree, their first ``seconds`` each, on the humanoid (a foreign rig retargeted)
     and rendered through the simulated devices as the datasets are (projected keypoints,
-    VR with realistic noise).
+    VR with realistic noise); with each clip's (group's) VR stream and standing height.
 
     Raises:
         DatasetError: the folder has no BVH file.
@@ -122,7 +151,7 @@ def mocap_examples(folder: Path, clips: int, seconds: float, seed: int = 0) -> E
         raise DatasetError(f"{folder}: no .bvh clip to evaluate on")
     picked = [files[i] for i in np.linspace(0, len(files) - 1, min(clips, len(files))).astype(int)]
     setup = VRSetup(devices=HEADSET_AND_CONTROLLERS, noise=REALISTIC_NOISE)
-    parts = []
+    parts, streams = [], {}
     for group, path in enumerate(picked):
         motion = read_bvh(path)
         humanoid = humanoid_for(motion[: int(seconds * motion.fps)])
@@ -133,6 +162,8 @@ def mocap_examples(folder: Path, clips: int, seconds: float, seed: int = 0) -> E
             stream.timestamps, stream.positions, stream.quaternions, stream.valid,
             stream.device_names,
         )  # fmt: skip
+        height = standing_height(humanoid.motion)
+        streams[group] = (stream, height)
         parts.append(
             recording_examples(
                 body17_positions(truth),
@@ -140,8 +171,8 @@ def mocap_examples(folder: Path, clips: int, seconds: float, seed: int = 0) -> E
                 recording.conf,
                 recording.time,
                 vr,
-                standing_height(humanoid.motion),
+                height,
                 group,
             )  # fmt: skip
         )
-    return concat(parts)
+    return concat(parts), streams

@@ -4,8 +4,10 @@ On the held-out split (``test``: subjects that never reached train), in §5.3's 
 frame (:func:`synthesis.controllerpose.evaluate.normalise`): the model's mean joint error
 overall and without hip and torso, each with its SD, per joint (a Fig. 9-like chart,
 ``per_joint.png``), the nearest-neighbour baseline on the same features (database: the
-train split), and, given ``--no-vr-model RUN`` (a model trained with ``--no-vr``), the
-§5.3 ablation without VR features and its increase over the full model (paper: +25.5%).
+train split), CoolMoves from the VR stream alone on the same frames (its database: the
+train split's motions, :mod:`scripts.controllerpose.coolmoves_baseline`), and, given
+``--no-vr-model RUN`` (a model trained with ``--no-vr``), the §5.3 ablation without VR
+features and its increase over the full model (paper: +25.5%).
 Given ``--mocap FOLDER``, the same on held-out real clips (Bandai, CMU) rendered through
 the simulated devices (:func:`scripts.controllerpose.data.mocap_examples`).
 """
@@ -20,7 +22,8 @@ import numpy as np
 from avatar_models.body17 import BODY17
 from avatar_models.errors import AvatarsimError
 from avatar_models.fileio import write_json
-from scripts.controllerpose.data import load_examples, mocap_examples
+from scripts.controllerpose.coolmoves_baseline import coolmoves_positions, training_motions
+from scripts.controllerpose.data import load_examples, mocap_examples, split_streams
 from scripts.controllerpose.figures import plt, save_png
 from synthesis.controllerpose.checkpoint import Checkpoint, load
 from synthesis.controllerpose.evaluate import (
@@ -31,6 +34,7 @@ from synthesis.controllerpose.evaluate import (
     summary,
 )
 from synthesis.controllerpose.examples import Examples
+from synthesis.coolmoves import build_database
 
 
 class EvaluationError(AvatarsimError, ValueError):
@@ -61,8 +65,10 @@ def split_results(
     ablation: Checkpoint | None,
     test: Examples,
     train: Examples,
+    coolmoves: np.ndarray | None = None,
 ) -> dict[str, dict]:
-    """The model, the nearest-neighbour baseline and the ablation on ``test``."""
+    """The model, the nearest-neighbour baseline, the ablation and CoolMoves' world
+    keypoints ``coolmoves (N, 17, 3)`` (when given) on ``test``."""
     truth = normalise(test.positions.astype(np.float64), test.height)
     results = {
         "controllerpose": summary(
@@ -76,6 +82,8 @@ def split_results(
         results["controllerpose-no-vr"] = summary(
             joint_errors(normalise(model_positions(ablation, test), test.height), truth)
         )
+    if coolmoves is not None:
+        results["coolmoves"] = summary(joint_errors(normalise(coolmoves, test.height), truth))
     return results
 
 
@@ -94,16 +102,25 @@ def run_evaluation(
     test = load_examples(data, "test", frame_stride)
     test.features.check_finite(f"{data} test split")
     train = load_examples(data, "train", frame_stride)
-    results = split_results(checkpoint, ablation_checkpoint, test, train)
+    database = build_database(training_motions(data))
+    results = split_results(
+        checkpoint,
+        ablation_checkpoint,
+        test,
+        train,
+        coolmoves_positions(database, split_streams(data, "test"), test),
+    )
     real = None
     if mocap is not None:
-        clips = mocap_examples(mocap, mocap_clips, MOCAP_SECONDS)
+        clips, streams = mocap_examples(mocap, mocap_clips, MOCAP_SECONDS)
         clips.features.check_finite(f"{mocap} clips")
+        clips = clips.take(np.arange(0, len(clips), frame_stride))
         real = split_results(
             checkpoint,
             ablation_checkpoint,
-            clips.take(np.arange(0, len(clips), frame_stride)),
+            clips,
             train,
+            coolmoves_positions(database, streams, clips),
         )
     full = results["controllerpose"]["mean_cm"]
     report = {

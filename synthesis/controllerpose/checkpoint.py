@@ -90,6 +90,25 @@ class Checkpoint:
         return path
 
 
+def untrained(
+    template_lengths: np.ndarray, net: NetConfig | None = None, seed: int = 0
+) -> Checkpoint:
+    """A checkpoint of a freshly initialised network (from ``seed``) with an identity
+    normaliser and ``template_lengths (17,)``: for timing and for testing the stages around
+    the network, whose weights do not matter there."""
+    net = net or NetConfig()
+    torch.manual_seed(seed)
+    slots = (LAYOUT["skeleton_slots"], LAYOUT["per_skeleton"])
+    normaliser = Normaliser(
+        np.zeros(slots, np.float32),
+        np.ones(slots, np.float32),
+        np.zeros(LAYOUT["vr_features"], np.float32),
+        np.ones(LAYOUT["vr_features"], np.float32),
+    )
+    weights = LiftingNet(net).state_dict()
+    return Checkpoint(net, weights, normaliser, np.asarray(template_lengths), {}, "", 0, [], {})
+
+
 def load(folder: str | Path) -> Checkpoint:
     """The checkpoint in run folder ``folder`` (or the file itself).
 

@@ -39,6 +39,8 @@ class Examples:
         positions: ``(N, 17, 3)`` keypoints, pelvis at the origin, heading frame.
         height: ``(N,)`` the subject's standing height (m), for §5.3's normalisation.
         group: ``(N,)`` int, the recording each example comes from.
+        time: ``(N,)`` the camera frame's time within its recording (s), so that another
+            method's output can be sampled at the same frames.
     """
 
     features: Features
@@ -47,6 +49,7 @@ class Examples:
     positions: np.ndarray
     height: np.ndarray
     group: np.ndarray
+    time: np.ndarray
 
     def __len__(self) -> int:
         return len(self.group)
@@ -136,4 +139,5 @@ def recording_examples(
         turned[keep].astype(np.float32),
         np.full(n, height, dtype=np.float32),
         np.full(n, group, dtype=np.int64),
+        np.asarray(frame_time, dtype=np.float64)[keep],
     )

@@ -46,9 +46,12 @@ def test_eval_reports_model_baseline_and_ablation(cp_run, cp_dataset, tmp_path):
     )  # fmt: skip
     assert result.exit_code == 0, result.output
     report = json.loads((tmp_path / "eval" / "eval.json").read_text())
-    assert set(report["results"]) == {"controllerpose", "nearest-neighbour", "controllerpose-no-vr"}
-    full = report["results"]["controllerpose"]
-    assert np.isfinite(full["mean_cm"]) and full["per_joint_cm"]["pelvis"] < 1e-6
+    methods = {"controllerpose", "nearest-neighbour", "controllerpose-no-vr", "coolmoves"}
+    assert set(report["results"]) == methods
+    for name in methods:  # the same frames, §5.3-normalised: the pelvis is the origin
+        res = report["results"][name]
+        assert res["frames"] == report["results"]["controllerpose"]["frames"]
+        assert np.isfinite(res["mean_cm"]) and res["per_joint_cm"]["pelvis"] < 1e-6
 
 
 def test_a_dataset_without_keypoints_exits_2(tmp_path):
@@ -102,3 +105,16 @@ def test_an_occupied_out_that_holds_no_run_exits_2(cp_dataset, tmp_path):
     assert sorted(p.name for p in occupied.iterdir()) == ["notes.txt"]
     result = runner.invoke(app, [*args, "--out", str(occupied / "notes.txt")])
     assert result.exit_code == 2 and "is a file" in result.output
+
+
+def test_the_shipped_scenario_without_a_model_exits_2_before_any_stage(tmp_path, monkeypatch):
+    from pathlib import Path
+
+    from synthesis.controllerpose.synthesizer import MODEL_ENV
+
+    scenario = Path(__file__).resolve().parents[3] / "scripts/scenarios/methods/controllerpose.toml"
+    monkeypatch.setenv(MODEL_ENV, str(tmp_path / "no-model"))
+    result = runner.invoke(app, ["run", str(scenario), "--out", str(tmp_path / "run")])
+    assert result.exit_code == 2
+    assert "no trained model" in result.output and "train controllerpose" in result.output
+    assert not (tmp_path / "run").exists()

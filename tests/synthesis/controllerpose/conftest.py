@@ -37,6 +37,7 @@ def make_examples(n: int, seed: int) -> Examples:
         centred.astype(np.float32),
         np.full(n, 1.75, dtype=np.float32),
         np.zeros(n, dtype=np.int64),
+        np.arange(n) / 30.0,
     )
 
 
