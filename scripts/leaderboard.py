@@ -12,11 +12,16 @@ keypoints), and AvatarGo's walk-in T-pose sample of the six VR devices, through
 are means over the trials of a class, then over classes (each class counts once, as the
 paper averages over activities); latency percentiles are those of all steps of a trial,
 averaged likewise.
+
+A long run resumes: with ``resume`` (the CLI passes ``OUT/folds``) each fold's rows are saved
+when it ends (atomically) and a later run with the same settings reuses them
+(:func:`saved_fold`).
 """
 
 from __future__ import annotations
 
 import html
+import json
 from collections.abc import Callable, Sequence
 from functools import cache
 from pathlib import Path
@@ -24,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from avatar_models import Motion
+from avatar_models.fileio import write_json
 from avatar_models.measure import standing_height
 from render_cams import VRSetup
 from render_cams.vr import FULL_BODY
@@ -147,6 +153,37 @@ def fold_rows(fold, setup: VRSetup, methods: Sequence[str], checks: CheckConfig,
     return out, failures
 
 
+def fold_key(fold, methods: Sequence[str], tune: bool) -> dict:
+    """What a fold's rows depend on besides the code: protocol, class, held-out group,
+    methods, tuning, and the names (and seeds) of its training and test trials."""
+    return {
+        "protocol": fold.protocol,
+        "class": fold.cls,
+        "held_out": fold.held_out,
+        "methods": list(methods),
+        "tune": tune,
+        "train": [t.name for t in fold.train],
+        "test": [[t.name, t.seed] for t in fold.test],
+    }
+
+
+def saved_fold(path: Path, key: dict, compute: Callable[[], dict]) -> tuple[dict, bool]:
+    """``(result, reused)``: the result saved at ``path`` when it was saved for ``key``,
+    else ``compute()``, saved there (atomically) for a later run. A result is a JSON dict;
+    NaN is saved as null and read back as NaN (:func:`avatar_models.fileio.write_json`)."""
+    if path.is_file():
+        saved = json.loads(path.read_text())
+        if saved.get("key") == key:
+            return saved["result"], True
+    result = compute()
+    write_json(path, {"key": key, "result": result})
+    return json.loads(path.read_text())["result"], False
+
+
+def _nan_for_null(row: dict) -> dict[str, float]:
+    return {k: float("nan") if v is None else float(v) for k, v in row.items()}
+
+
 def _mean_rows(rows: list[dict]) -> dict[str, float]:
     return {k: float(np.mean([r[k] for r in rows])) for k in rows[0]}
 
@@ -159,14 +196,17 @@ def run_leaderboard(
     checks: CheckConfig | None = None,
     tune: bool = True,
     progress: Callable[[int, int, str], None] | None = None,
+    resume: Path | None = None,
 ) -> dict:
     """Every method of ``methods`` (default: every registered one that is ready,
     :func:`~synthesis.methods.ready_methods`) on the test trials of
     ``protocol``.
 
     Returns ``{"protocol", "methods": {name: {column: value}}, "per_class": {class: {name:
-    {column: value}}}, "trials", "failed_folds", "failed_methods", "skipped"}``; a method
-    that fails on a trial (``failed_methods``) leaves the other methods' rows of it.
+    {column: value}}}, "trials", "failed_folds", "failed_methods", "skipped", "resumed"}``;
+    a method that fails on a trial (``failed_methods``) leaves the other methods' rows of it.
+    ``resume``: a folder where each fold's rows are saved and, from an earlier run with the
+    same settings (:func:`fold_key`), reused (``resumed`` counts those folds).
     """
     methods = list(methods or ready_methods())
     sensors_of(methods)  # every sensor can be recorded, checked before any work
@@ -175,15 +215,28 @@ def run_leaderboard(
         raise EvaluationError(f"no class can be evaluated {protocol}: {skipped}")
     # Every device, Vive trackers included (AvatarGo's); the others read only theirs.
     setup, checks = setup or VRSetup(devices=FULL_BODY), checks or CheckConfig()
-    rows, failed, method_failures, n_trials = [], [], [], 0
-    for i, fold in enumerate(all_folds):
+    rows, failed, method_failures, n_trials, resumed = [], [], [], 0, 0
+
+    def run_fold(fold) -> dict:
         try:
             fold_out, fold_failures = fold_rows(fold, setup, methods, checks, tune)
         except SynthesisError as exc:  # e.g. no training clip passes the correlation filter
-            failed.append({"class": fold.cls, "held_out": fold.held_out, "reason": str(exc)})
+            return {"failed": {"class": fold.cls, "held_out": fold.held_out, "reason": str(exc)}}
+        return {"rows": fold_out, "failures": fold_failures}
+
+    for i, fold in enumerate(all_folds):
+        if resume is None:
+            result = run_fold(fold)
         else:
-            rows.extend(fold_out)
-            method_failures.extend(fold_failures)
+            key = fold_key(fold, methods, tune)
+            path = Path(resume) / f"fold-{i:03d}.json"
+            result, reused = saved_fold(path, key, lambda fold=fold: run_fold(fold))
+            resumed += reused
+        if "failed" in result:
+            failed.append(result["failed"])
+        else:
+            rows.extend((c, m, _nan_for_null(r)) for c, m, r in result["rows"])
+            method_failures.extend(result["failures"])
             n_trials += len(fold.test)
         if progress is not None:
             progress(i + 1, len(all_folds), f"{fold.cls} / {fold.held_out}")
@@ -207,6 +260,7 @@ def run_leaderboard(
         "failed_folds": failed,
         "failed_methods": method_failures,
         "skipped": skipped,
+        "resumed": resumed,
         "columns": COLUMNS,
     }
 

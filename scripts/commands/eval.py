@@ -3,9 +3,10 @@
 CoolMoves' accuracy protocols (§4.1) with the IK baseline beside: prints the per-class and
 overall tables, writes the contract JSON and Fig. 4-like bar plots into ``--out``.
 ``eval leaderboard`` runs every registered method instead (:mod:`scripts.leaderboard`) and
-writes ``leaderboard.json``, ``.png`` and ``.html``; ``eval avatargo`` runs AvatarGo's
-simulated user study, exact against fixed offsets (:mod:`scripts.avatargo_eval`), and
-writes ``avatargo.json`` and ``avatargo.png``. Exit 2 for
+writes ``leaderboard.json``, ``.png`` and ``.html`` (each fold's rows saved in ``OUT/folds``:
+a rerun with the same settings resumes; delete it after changing the code); ``eval
+avatargo`` runs AvatarGo's simulated user study, exact against fixed offsets
+(:mod:`scripts.avatargo_eval`), and writes ``avatargo.json`` and ``avatargo.png``. Exit 2 for
 bad input (unknown method or protocol, a folder without clips, cross-subject on clips
 without subject labels).
 """
@@ -379,13 +380,20 @@ def register(app: typer.Typer) -> None:
             def progress(done: int, total: int, label: str) -> None:
                 bar.update(task, completed=done, total=total, description=escape(label))
 
+            def fold_done(done: int, total: int, label: str) -> None:
+                # A line per fold too: a long leaderboard is often run into a log file.
+                progress(done, total, label)
+                err_console.print(f"fold {done}/{total} done: {escape(label)}")
+
             if method == "avatargo":
                 results = run_avatargo_eval(trials, duration, progress=progress)
                 results.update(library=library, seed=seed, quick=quick, class_by=class_by)
                 write_avatargo(results, out, json_out)
                 return
             if method == "leaderboard":
-                board = run_leaderboard(trials, protocol, board_methods, progress=progress)
+                board = run_leaderboard(
+                    trials, protocol, board_methods, progress=fold_done, resume=out / "folds"
+                )
                 board.update(library=library, seed=seed, quick=quick, class_by=class_by)
                 write_leaderboard(board, out, json_out)
                 return
