@@ -167,6 +167,13 @@ def fold_key(fold, methods: Sequence[str], tune: bool) -> dict:
     }
 
 
+def fold_file(fold) -> str:
+    """The file name of a fold's saved rows: its class and held-out group, so that a run on
+    some classes (``--classes``) finds the folds a run on all of them saved."""
+    name = f"{fold.cls}--{fold.held_out}"
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) + ".json"
+
+
 def saved_fold(path: Path, key: dict, compute: Callable[[], dict]) -> tuple[dict, bool]:
     """``(result, reused)``: the result saved at ``path`` when it was saved for ``key``,
     else ``compute()``, saved there (atomically) for a later run. A result is a JSON dict;
@@ -229,7 +236,7 @@ def run_leaderboard(
             result = run_fold(fold)
         else:
             key = fold_key(fold, methods, tune)
-            path = Path(resume) / f"fold-{i:03d}.json"
+            path = Path(resume) / fold_file(fold)
             result, reused = saved_fold(path, key, lambda fold=fold: run_fold(fold))
             resumed += reused
         if "failed" in result:

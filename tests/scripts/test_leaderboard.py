@@ -115,7 +115,7 @@ def test_a_rerun_resumes_saved_folds_and_redoes_changed_ones(tmp_path, monkeypat
 
     trials = builtin_trials(("box",), n_subjects=2, n_takes=1, duration_s=1.0, seed=0)
     first = run_leaderboard(trials, "cross-subject", ["ik"], tune=False, resume=tmp_path)
-    assert first["resumed"] == 0 and len(list(tmp_path.glob("fold-*.json"))) == 2
+    assert first["resumed"] == 0 and len(list(tmp_path.glob("box--*.json"))) == 2
     computed = []
     real = leaderboard.fold_rows
     monkeypatch.setattr(leaderboard, "fold_rows", lambda *a: computed.append(a[0]) or real(*a))
