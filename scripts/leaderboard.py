@@ -33,6 +33,7 @@ from avatar_models.fileio import write_json
 from avatar_models.measure import standing_height
 from render_cams import VRSetup
 from render_cams.vr import FULL_BODY
+from scripts.dataset import executors
 from scripts.method_score import score_method
 from scripts.movebox_eval import filmed
 from scripts.report_html import image_html, page, table_html
@@ -187,6 +188,34 @@ def saved_fold(path: Path, key: dict, compute: Callable[[], dict]) -> tuple[dict
     return json.loads(path.read_text())["result"], False
 
 
+def fold_result(
+    i: int,
+    fold,
+    setup: VRSetup,
+    methods: Sequence[str],
+    checks: CheckConfig,
+    tune: bool,
+    resume: Path | None,
+) -> tuple[int, dict, bool]:
+    """``(i, result, reused)`` for fold ``i``: ``{"rows", "failures"}`` of
+    :func:`fold_rows`, or ``{"failed": {"class", "held_out", "reason"}}`` when the fold
+    cannot be run (e.g. no training clip passes the correlation filter); saved in and
+    reused from ``resume`` when given (:func:`saved_fold`). Module-level: pool workers run it.
+    """
+
+    def compute() -> dict:
+        try:
+            fold_out, fold_failures = fold_rows(fold, setup, methods, checks, tune)
+        except SynthesisError as exc:
+            return {"failed": {"class": fold.cls, "held_out": fold.held_out, "reason": str(exc)}}
+        return {"rows": fold_out, "failures": fold_failures}
+
+    if resume is None:
+        return i, compute(), False
+    path = Path(resume) / fold_file(fold)
+    return i, *saved_fold(path, fold_key(fold, list(methods), tune), compute)
+
+
 def _nan_for_null(row: dict) -> dict[str, float]:
     return {k: float("nan") if v is None else float(v) for k, v in row.items()}
 
@@ -204,6 +233,7 @@ def run_leaderboard(
     tune: bool = True,
     progress: Callable[[int, int, str], None] | None = None,
     resume: Path | None = None,
+    workers: int = 1,
 ) -> dict:
     """Every method of ``methods`` (default: every registered one that is ready,
     :func:`~synthesis.methods.ready_methods`) on the test trials of
@@ -213,7 +243,9 @@ def run_leaderboard(
     {column: value}}}, "trials", "failed_folds", "failed_methods", "skipped", "resumed"}``;
     a method that fails on a trial (``failed_methods``) leaves the other methods' rows of it.
     ``resume``: a folder where each fold's rows are saved and, from an earlier run with the
-    same settings (:func:`fold_key`), reused (``resumed`` counts those folds).
+    same settings (:func:`fold_key`), reused (``resumed`` counts those folds). ``workers``:
+    folds run in that many processes (:func:`scripts.dataset.executors.run`); ``progress``
+    is called as each ends, in the order they end.
     """
     methods = list(methods or ready_methods())
     sensors_of(methods)  # every sensor can be recorded, checked before any work
@@ -222,31 +254,22 @@ def run_leaderboard(
         raise EvaluationError(f"no class can be evaluated {protocol}: {skipped}")
     # Every device, Vive trackers included (AvatarGo's); the others read only theirs.
     setup, checks = setup or VRSetup(devices=FULL_BODY), checks or CheckConfig()
-    rows, failed, method_failures, n_trials, resumed = [], [], [], 0, 0
-
-    def run_fold(fold) -> dict:
-        try:
-            fold_out, fold_failures = fold_rows(fold, setup, methods, checks, tune)
-        except SynthesisError as exc:  # e.g. no training clip passes the correlation filter
-            return {"failed": {"class": fold.cls, "held_out": fold.held_out, "reason": str(exc)}}
-        return {"rows": fold_out, "failures": fold_failures}
-
-    for i, fold in enumerate(all_folds):
-        if resume is None:
-            result = run_fold(fold)
-        else:
-            key = fold_key(fold, methods, tune)
-            path = Path(resume) / fold_file(fold)
-            result, reused = saved_fold(path, key, lambda fold=fold: run_fold(fold))
-            resumed += reused
+    items = [(i, f, setup, methods, checks, tune, resume) for i, f in enumerate(all_folds)]
+    results: list[dict] = [{}] * len(all_folds)
+    resumed = 0
+    finished = executors.run(fold_result, items, workers=workers)
+    for done, (i, result, reused) in enumerate(finished, 1):
+        results[i], resumed = result, resumed + reused
+        if progress is not None:
+            progress(done, len(all_folds), f"{all_folds[i].cls} / {all_folds[i].held_out}")
+    rows, failed, method_failures, n_trials = [], [], [], 0
+    for fold, result in zip(all_folds, results, strict=True):
         if "failed" in result:
             failed.append(result["failed"])
         else:
             rows.extend((c, m, _nan_for_null(r)) for c, m, r in result["rows"])
             method_failures.extend(result["failures"])
             n_trials += len(fold.test)
-        if progress is not None:
-            progress(i + 1, len(all_folds), f"{fold.cls} / {fold.held_out}")
     if not rows:
         raise EvaluationError(f"every fold failed: {failed[:3]}")
     classes = sorted({c for c, _, _ in rows})

@@ -276,6 +276,9 @@ def register(app: typer.Typer) -> None:
             str | None,
             typer.Option(help="leaderboard: comma-separated methods (default: every ready one)."),
         ] = None,
+        workers: Annotated[
+            int, typer.Option(help="leaderboard: folds run in this many processes.")
+        ] = 1,
         audio: Annotated[
             Path | None,
             typer.Option(help="movebox: a WAV file or folder for lip sync (the story's voice)."),
@@ -331,6 +334,7 @@ def register(app: typer.Typer) -> None:
             ("--heading", heading, 0.0, 180.0),
             ("--db-headings", db_headings, 1, 36),
             ("--max-per-class", 1 if max_per_class is None else max_per_class, 1, 100_000),
+            ("--workers", workers, 1, 256),
         ):
             if not lo <= value <= hi:  # also NaN
                 raise EvaluationError(f"{option} must be {lo:g}-{hi:g}, got {value}")
@@ -392,7 +396,12 @@ def register(app: typer.Typer) -> None:
                 return
             if method == "leaderboard":
                 board = run_leaderboard(
-                    trials, protocol, board_methods, progress=fold_done, resume=out / "folds"
+                    trials,
+                    protocol,
+                    board_methods,
+                    progress=fold_done,
+                    resume=out / "folds",
+                    workers=workers,
                 )
                 board.update(library=library, seed=seed, quick=quick, class_by=class_by)
                 write_leaderboard(board, out, json_out)

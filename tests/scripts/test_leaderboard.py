@@ -114,7 +114,8 @@ def test_a_rerun_resumes_saved_folds_and_redoes_changed_ones(tmp_path, monkeypat
     from synthesis.evaluate import builtin_trials
 
     trials = builtin_trials(("box",), n_subjects=2, n_takes=1, duration_s=1.0, seed=0)
-    first = run_leaderboard(trials, "cross-subject", ["ik"], tune=False, resume=tmp_path)
+    # Two worker processes, one fold each.
+    first = run_leaderboard(trials, "cross-subject", ["ik"], tune=False, resume=tmp_path, workers=2)
     assert first["resumed"] == 0 and len(list(tmp_path.glob("box--*.json"))) == 2
     computed = []
     real = leaderboard.fold_rows
@@ -122,6 +123,10 @@ def test_a_rerun_resumes_saved_folds_and_redoes_changed_ones(tmp_path, monkeypat
     again = run_leaderboard(trials, "cross-subject", ["ik"], tune=False, resume=tmp_path)
     assert again["resumed"] == 2 and not computed
     assert again["methods"] == first["methods"]
-    # Other methods are other settings: nothing saved is reused for them.
-    other = run_leaderboard(trials, "cross-subject", ["coolmoves"], tune=False, resume=tmp_path)
+    # Other methods are other settings: nothing saved is reused for them; in this process
+    # the IK's accuracy is what the workers measured.
+    methods = ["ik", "coolmoves"]
+    other = run_leaderboard(trials, "cross-subject", methods, tune=False, resume=tmp_path)
     assert other["resumed"] == 0 and len(computed) == 2
+    for key in ("hands_cm", "full_cm", "penetration_cm_p95"):
+        assert other["methods"]["ik"][key] == pytest.approx(first["methods"]["ik"][key])
