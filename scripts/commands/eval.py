@@ -96,6 +96,8 @@ def write_leaderboard(board: dict, out: Path, json_out: Path | None) -> None:
             "[yellow]method failed[/] "
             + escape(f"{fail['method']} on {fail['class']}: {fail['reason']}")
         )
+    if board.get("resumed"):
+        console.print(f"{board['resumed']} fold(s) resumed from {out}/folds")
     out.mkdir(parents=True, exist_ok=True)
     plot = write_plot(board, out / "leaderboard.png")
     (out / "leaderboard.html").write_text(render_page(board, plot))
