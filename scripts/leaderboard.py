@@ -169,8 +169,9 @@ def fold_key(fold, methods: Sequence[str], tune: bool) -> dict:
 
 
 def fold_file(fold) -> str:
-    """The file name of a fold's saved rows: its class and held-out group, so that a run on
-    some classes (``--classes``) finds the folds a run on all of them saved."""
+    """The file name of a fold's saved rows: its class and held-out group. A run on other
+    trials (e.g. ``--classes``: :func:`~synthesis.evaluate.library_trials` draws the trials'
+    seeds over the selected classes) has another :func:`fold_key` and recomputes it."""
     name = f"{fold.cls}--{fold.held_out}"
     return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) + ".json"
 
