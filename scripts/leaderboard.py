@@ -12,11 +12,16 @@ keypoints), and AvatarGo's walk-in T-pose sample of the six VR devices, through
 are means over the trials of a class, then over classes (each class counts once, as the
 paper averages over activities); latency percentiles are those of all steps of a trial,
 averaged likewise.
+
+A long run resumes: with ``resume`` (the CLI passes ``OUT/folds``) each fold's rows are saved
+when it ends (atomically) and a later run with the same settings reuses them
+(:func:`saved_fold`).
 """
 
 from __future__ import annotations
 
 import html
+import json
 from collections.abc import Callable, Sequence
 from functools import cache
 from pathlib import Path
@@ -24,9 +29,11 @@ from pathlib import Path
 import numpy as np
 
 from avatar_models import Motion
+from avatar_models.fileio import write_json
 from avatar_models.measure import standing_height
 from render_cams import VRSetup
 from render_cams.vr import FULL_BODY
+from scripts.dataset import executors
 from scripts.method_score import score_method
 from scripts.movebox_eval import body17_tracked, filmed
 from scripts.report_html import image_html, page, table_html
@@ -191,6 +198,80 @@ def tracked_notes(board: dict) -> list[str]:
     ]
 
 
+FOLD_FORMAT = 2
+"""The saved fold's layout; 2: with the sensors' tracked shares. A fold saved in another
+layout is recomputed."""
+
+
+def fold_key(fold, methods: Sequence[str], tune: bool) -> dict:
+    """What a fold's rows depend on besides the code: the saved format
+    (:data:`FOLD_FORMAT`), protocol, class, held-out group, methods, tuning, and the names (and
+    seeds) of its training and test trials."""
+    return {
+        "format": FOLD_FORMAT,
+        "protocol": fold.protocol,
+        "class": fold.cls,
+        "held_out": fold.held_out,
+        "methods": list(methods),
+        "tune": tune,
+        "train": [t.name for t in fold.train],
+        "test": [[t.name, t.seed] for t in fold.test],
+    }
+
+
+def fold_file(fold) -> str:
+    """The file name of a fold's saved rows: its class and held-out group. A run on other
+    trials (e.g. ``--classes``: :func:`~synthesis.evaluate.library_trials` draws the trials'
+    seeds over the selected classes) has another :func:`fold_key` and recomputes it."""
+    name = f"{fold.cls}--{fold.held_out}"
+    return "".join(c if c.isalnum() or c in "-_." else "_" for c in name) + ".json"
+
+
+def saved_fold(path: Path, key: dict, compute: Callable[[], dict]) -> tuple[dict, bool]:
+    """``(result, reused)``: the result saved at ``path`` when it was saved for ``key``,
+    else ``compute()``, saved there (atomically) for a later run. A result is a JSON dict;
+    NaN is saved as null and read back as NaN (:func:`avatar_models.fileio.write_json`)."""
+    if path.is_file():
+        saved = json.loads(path.read_text())
+        if saved.get("key") == key:
+            return saved["result"], True
+    result = compute()
+    write_json(path, {"key": key, "result": result})
+    return json.loads(path.read_text())["result"], False
+
+
+def fold_result(
+    i: int,
+    fold,
+    setup: VRSetup,
+    methods: Sequence[str],
+    checks: CheckConfig,
+    tune: bool,
+    resume: Path | None,
+) -> tuple[int, dict, bool]:
+    """``(i, result, reused)`` for fold ``i``: ``{"rows", "failures"}`` of
+    :func:`fold_rows`, or ``{"failed": {"class", "held_out", "reason"}}`` when the fold
+    cannot be run (e.g. no training clip passes the correlation filter); saved in and
+    reused from ``resume`` when given (:func:`saved_fold`). Module-level: pool workers run it.
+    """
+
+    def compute() -> dict:
+        try:
+            fold_out, fold_failures, fold_shares = fold_rows(fold, setup, methods, checks, tune)
+        except SynthesisError as exc:
+            return {"failed": {"class": fold.cls, "held_out": fold.held_out, "reason": str(exc)}}
+        return {"rows": fold_out, "failures": fold_failures, "shares": fold_shares}
+
+    if resume is None:
+        return i, compute(), False
+    path = Path(resume) / fold_file(fold)
+    return i, *saved_fold(path, fold_key(fold, list(methods), tune), compute)
+
+
+def _nan_for_null(row: dict) -> dict[str, float]:
+    return {k: float("nan") if v is None else float(v) for k, v in row.items()}
+
+
 def _mean_rows(rows: list[dict]) -> dict[str, float]:
     return {k: float(np.mean([r[k] for r in rows])) for k in rows[0]}
 
@@ -203,15 +284,21 @@ def run_leaderboard(
     checks: CheckConfig | None = None,
     tune: bool = True,
     progress: Callable[[int, int, str], None] | None = None,
+    resume: Path | None = None,
+    workers: int = 1,
 ) -> dict:
     """Every method of ``methods`` (default: every registered one that is ready,
     :func:`~synthesis.methods.ready_methods`) on the test trials of
     ``protocol``.
 
     Returns ``{"protocol", "methods": {name: {column: value}}, "per_class": {class: {name:
-    {column: value}}}, "trials", "failed_folds", "failed_methods", "skipped",
+    {column: value}}}, "trials", "failed_folds", "failed_methods", "skipped", "resumed",
     "sensor_tracked"}`` (:func:`tracked_summary`); a method that fails on a trial
     (``failed_methods``) leaves the other methods' rows of it.
+    ``resume``: a folder where each fold's rows are saved and, from an earlier run with the
+    same settings (:func:`fold_key`), reused (``resumed`` counts those folds). ``workers``:
+    folds run in that many processes (:func:`scripts.dataset.executors.run`); ``progress``
+    is called as each ends, in the order they end.
     """
     methods = list(methods or ready_methods())
     sensors_of(methods)  # every sensor can be recorded, checked before any work
@@ -220,19 +307,23 @@ def run_leaderboard(
         raise EvaluationError(f"no class can be evaluated {protocol}: {skipped}")
     # Every device, Vive trackers included (AvatarGo's); the others read only theirs.
     setup, checks = setup or VRSetup(devices=FULL_BODY), checks or CheckConfig()
-    rows, failed, method_failures, shares, n_trials = [], [], [], [], 0
-    for i, fold in enumerate(all_folds):
-        try:
-            fold_out, fold_failures, fold_shares = fold_rows(fold, setup, methods, checks, tune)
-        except SynthesisError as exc:  # e.g. no training clip passes the correlation filter
-            failed.append({"class": fold.cls, "held_out": fold.held_out, "reason": str(exc)})
-        else:
-            rows.extend(fold_out)
-            method_failures.extend(fold_failures)
-            shares.extend(fold_shares)
-            n_trials += len(fold.test)
+    items = [(i, f, setup, methods, checks, tune, resume) for i, f in enumerate(all_folds)]
+    results: list[dict] = [{}] * len(all_folds)
+    resumed = 0
+    finished = executors.run(fold_result, items, workers=workers)
+    for done, (i, result, reused) in enumerate(finished, 1):
+        results[i], resumed = result, resumed + reused
         if progress is not None:
-            progress(i + 1, len(all_folds), f"{fold.cls} / {fold.held_out}")
+            progress(done, len(all_folds), f"{all_folds[i].cls} / {all_folds[i].held_out}")
+    rows, failed, method_failures, shares, n_trials = [], [], [], [], 0
+    for fold, result in zip(all_folds, results, strict=True):
+        if "failed" in result:
+            failed.append(result["failed"])
+        else:
+            rows.extend((c, m, _nan_for_null(r)) for c, m, r in result["rows"])
+            method_failures.extend(result["failures"])
+            shares.extend(result["shares"])
+            n_trials += len(fold.test)
     if not rows:
         raise EvaluationError(f"every fold failed: {failed[:3]}")
     classes = sorted({c for c, _, _ in rows})
@@ -253,6 +344,7 @@ def run_leaderboard(
         "failed_folds": failed,
         "failed_methods": method_failures,
         "skipped": skipped,
+        "resumed": resumed,
         "columns": COLUMNS,
         "sensor_tracked": tracked_summary(shares, methods),
     }

@@ -3,9 +3,10 @@
 CoolMoves' accuracy protocols (§4.1) with the IK baseline beside: prints the per-class and
 overall tables, writes the contract JSON and Fig. 4-like bar plots into ``--out``.
 ``eval leaderboard`` runs every registered method instead (:mod:`scripts.leaderboard`) and
-writes ``leaderboard.json``, ``.png`` and ``.html``; ``eval avatargo`` runs AvatarGo's
-simulated user study, exact against fixed offsets (:mod:`scripts.avatargo_eval`), and
-writes ``avatargo.json`` and ``avatargo.png``. Exit 2 for
+writes ``leaderboard.json``, ``.png`` and ``.html`` (each fold's rows saved in ``OUT/folds``:
+a rerun with the same settings resumes; delete it after changing the code); ``eval
+avatargo`` runs AvatarGo's simulated user study, exact against fixed offsets
+(:mod:`scripts.avatargo_eval`), and writes ``avatargo.json`` and ``avatargo.png``. Exit 2 for
 bad input (unknown method or protocol, a folder without clips, cross-subject on clips
 without subject labels).
 """
@@ -97,6 +98,8 @@ def write_leaderboard(board: dict, out: Path, json_out: Path | None) -> None:
             "[yellow]method failed[/] "
             + escape(f"{fail['method']} on {fail['class']}: {fail['reason']}")
         )
+    if board.get("resumed"):
+        console.print(f"{board['resumed']} fold(s) resumed from {out}/folds")
     out.mkdir(parents=True, exist_ok=True)
     plot = write_plot(board, out / "leaderboard.png")
     (out / "leaderboard.html").write_text(render_page(board, plot))
@@ -291,6 +294,9 @@ def register(app: typer.Typer) -> None:
             str | None,
             typer.Option(help="leaderboard: comma-separated methods (default: every ready one)."),
         ] = None,
+        workers: Annotated[
+            int, typer.Option(help="leaderboard: folds run in this many processes.")
+        ] = 1,
         audio: Annotated[
             Path | None,
             typer.Option(help="movebox: a WAV file or folder for lip sync (the story's voice)."),
@@ -346,6 +352,7 @@ def register(app: typer.Typer) -> None:
             ("--heading", heading, 0.0, 180.0),
             ("--db-headings", db_headings, 1, 36),
             ("--max-per-class", 1 if max_per_class is None else max_per_class, 1, 100_000),
+            ("--workers", workers, 1, 256),
         ):
             if not lo <= value <= hi:  # also NaN
                 raise EvaluationError(f"{option} must be {lo:g}-{hi:g}, got {value}")
@@ -395,13 +402,25 @@ def register(app: typer.Typer) -> None:
             def progress(done: int, total: int, label: str) -> None:
                 bar.update(task, completed=done, total=total, description=escape(label))
 
+            def fold_done(done: int, total: int, label: str) -> None:
+                # A line per fold too: a long leaderboard is often run into a log file.
+                progress(done, total, label)
+                err_console.print(f"fold {done}/{total} done: {escape(label)}")
+
             if method == "avatargo":
                 results = run_avatargo_eval(trials, duration, progress=progress)
                 results.update(library=library, seed=seed, quick=quick, class_by=class_by)
                 write_avatargo(results, out, json_out)
                 return
             if method == "leaderboard":
-                board = run_leaderboard(trials, protocol, board_methods, progress=progress)
+                board = run_leaderboard(
+                    trials,
+                    protocol,
+                    board_methods,
+                    progress=fold_done,
+                    resume=out / "folds",
+                    workers=workers,
+                )
                 board.update(library=library, seed=seed, quick=quick, class_by=class_by)
                 write_leaderboard(board, out, json_out)
                 return

@@ -42,6 +42,7 @@ def test_eval_builtin_writes_contract_json_and_plots(tmp_path):
         (["eval", "coolmoves", "--library", "/no/such/folder"], "not"),
         (["eval", "leaderboard", "--methods", "ik,magic"], "--methods"),
         (["eval", "coolmoves", "--methods", "ik"], "--methods"),
+        (["eval", "leaderboard", "--workers", "0"], "--workers"),
     ],
 )
 def test_bad_input_exits_2_with_a_reason(args, reason):

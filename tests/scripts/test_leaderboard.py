@@ -121,3 +121,26 @@ def test_a_method_failing_on_a_trial_leaves_the_others_rows(monkeypatch):
     assert set(board["methods"]) == {"ik"} and board["trials"] == 2
     assert [f["method"] for f in board["failed_methods"]] == ["probe", "probe"]
     assert "cannot run here" in board["failed_methods"][0]["reason"]
+
+
+def test_a_rerun_resumes_saved_folds_and_redoes_changed_ones(tmp_path, monkeypatch):
+    from scripts import leaderboard
+    from synthesis.evaluate import builtin_trials
+
+    trials = builtin_trials(("box",), n_subjects=2, n_takes=1, duration_s=1.0, seed=0)
+    # Two worker processes, one fold each.
+    first = run_leaderboard(trials, "cross-subject", ["ik"], tune=False, resume=tmp_path, workers=2)
+    assert first["resumed"] == 0 and len(list(tmp_path.glob("box--*.json"))) == 2
+    computed = []
+    real = leaderboard.fold_rows
+    monkeypatch.setattr(leaderboard, "fold_rows", lambda *a: computed.append(a[0]) or real(*a))
+    again = run_leaderboard(trials, "cross-subject", ["ik"], tune=False, resume=tmp_path)
+    assert again["resumed"] == 2 and not computed
+    assert again["methods"] == first["methods"]
+    # Other methods are other settings: nothing saved is reused for them; in this process
+    # the IK's accuracy is what the workers measured.
+    methods = ["ik", "coolmoves"]
+    other = run_leaderboard(trials, "cross-subject", methods, tune=False, resume=tmp_path)
+    assert other["resumed"] == 0 and len(computed) == 2
+    for key in ("hands_cm", "full_cm", "penetration_cm_p95"):
+        assert other["methods"]["ik"][key] == pytest.approx(first["methods"]["ik"][key])
