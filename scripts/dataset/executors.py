@@ -88,12 +88,16 @@ def _pool(fn: Callable[..., Any], items: Sequence[tuple], workers: int) -> Itera
         initializer=_single_threaded_child_of,
         initargs=(os.getpid(),),
     )
+    completed = False
     try:
         for future in as_completed([pool.submit(fn, *item) for item in items]):
             yield future.result()
+        completed = True
     finally:
-        # On an error, SIGTERM or an abandoned iteration: start no more items.
-        pool.shutdown(wait=True, cancel_futures=True)
+        # On an error, SIGTERM or an abandoned iteration: start no more items, and do not wait
+        # for the running ones (a leaderboard fold runs for minutes): the workers exit as soon
+        # as this process does (_single_threaded_child_of).
+        pool.shutdown(wait=completed, cancel_futures=True)
 
 
 def _single_threaded(fn: Callable[..., Any], *args: Any) -> Any:
