@@ -21,7 +21,7 @@ import threading
 import time
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
-from multiprocessing import get_context
+from multiprocessing import active_children, get_context
 from typing import Any
 
 from avatar_models.errors import AvatarsimError
@@ -82,6 +82,7 @@ def _single_threaded_child_of(parent: int) -> None:
 
 
 def _pool(fn: Callable[..., Any], items: Sequence[tuple], workers: int) -> Iterator[Any]:
+    before = set(active_children())
     pool = ProcessPoolExecutor(
         max_workers=workers,
         mp_context=get_context("spawn"),
@@ -94,10 +95,13 @@ def _pool(fn: Callable[..., Any], items: Sequence[tuple], workers: int) -> Itera
             yield future.result()
         completed = True
     finally:
-        # On an error, SIGTERM or an abandoned iteration: start no more items, and do not wait
-        # for the running ones (a leaderboard fold runs for minutes): the workers exit as soon
-        # as this process does (_single_threaded_child_of).
+        # On an error, SIGTERM or an abandoned iteration: start no more items, and stop the
+        # running ones (a leaderboard fold runs for minutes), since concurrent.futures would
+        # otherwise wait for them when this process exits.
         pool.shutdown(wait=completed, cancel_futures=True)
+        if not completed:
+            for worker in set(active_children()) - before:
+                worker.terminate()
 
 
 def _single_threaded(fn: Callable[..., Any], *args: Any) -> Any:

@@ -4,6 +4,7 @@ SIGTERM as SystemExit, a consumer that stops) does not wait for the items still 
 from __future__ import annotations
 
 import time
+from multiprocessing import active_children
 from pathlib import Path
 
 from scripts.dataset.executors import run
@@ -25,3 +26,7 @@ def test_abandoned_pool_run_does_not_wait_for_running_items(tmp_path):
     assert next(results) == str(quick)
     results.close()  # what SystemExit or an error in the consumer does to the generator
     assert not slow.exists()  # the slow item was still running when close() returned
+    for worker in active_children():  # stopped, not left to finish (or to hold up our exit)
+        worker.join(SLOW_ITEM_S / 2)
+    assert not active_children()
+    assert not slow.exists()
