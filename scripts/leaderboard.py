@@ -99,7 +99,7 @@ TRACKED_SHARE: dict[str, Callable[[object], float]] = {
 """For a recorded sensor that can lose the performer (out of its view or range): the share of
 a trial's frames in which it tracks every body17 joint. A method reading it holds the last
 pose elsewhere, so its error there grows with how far the performer went (CMU 102_01, a
-basketball drive: MoveBox 103 cm over every tick, 14 cm over the tracked ones); the board
+basketball drive: MoveBox 99 cm over every tick, 8.7 cm over the tracked ones); the board
 reports the share per class beside the errors (:func:`tracked_notes`)."""
 
 
