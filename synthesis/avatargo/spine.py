@@ -3,8 +3,14 @@
 At the walk-in T-pose AvatarGo stores ``w0 = p0(T_head) - p0(T_root)`` (eq. 1), the vector
 from the back tracker to the headset. At run time the back bends by
 ``alpha_t = angle(w0, w_t)`` (eq. 4), about the axis ``w0 x w_t`` that turns one into the
-other, applied to the spine by forward kinematics. Ours applies it to the avatar's rest
-pelvis-to-neck vector and gives the bent neck position to the IK as a soft target.
+other, applied to the spine by forward kinematics: :func:`spine_bend`.
+
+The avatar's root also turns with the back tracker (eq. 3), and the spine hangs from it, so
+the analytic IK (:mod:`synthesis.avatargo.analytic_ik`) measures eq. 4 in the root's frame
+(:func:`spine_bend_in_root`): a turn or lean of the whole body is then the root's rotation,
+not counted a second time as a bend. With the root's rotation unchanged since the walk-in
+it is eq. 4's rotation exactly. The QP solvers use :func:`spine_bend` in the world frame on
+the rest pelvis-to-neck vector, as a soft target for the neck.
 """
 
 from __future__ import annotations
@@ -12,9 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from avatar_models import quat
-
-MIN_AXIS = 1e-9
-"""Below this ``|w0 x w_t| / (|w0| |w_t|)`` the two vectors are parallel: no bend."""
+from synthesis.two_bone import shortest_arc
 
 
 def bend_angle(w0: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -25,11 +29,14 @@ def bend_angle(w0: np.ndarray, w: np.ndarray) -> np.ndarray:
 
 def spine_bend(w0: np.ndarray, w: np.ndarray) -> np.ndarray:
     """``(B, 4)`` wxyz rotations by ``alpha_t`` about ``w0 x w_t`` (identity where parallel):
-    each turns the direction of ``w0 (3,)`` onto that of ``w (B, 3)``."""
-    axis = np.cross(w0, w)
-    norm = np.linalg.norm(axis, axis=-1, keepdims=True)
-    scale = np.linalg.norm(w0) * np.linalg.norm(w, axis=-1, keepdims=True)
-    parallel = norm <= MIN_AXIS * scale
-    axis = np.where(parallel, [0.0, 0.0, 1.0], axis / np.where(parallel, 1.0, norm))
-    alpha = np.where(parallel[..., 0], 0.0, bend_angle(w0, w))
-    return quat.from_axis_angle(axis, alpha)
+    each turns the direction of ``w0 (3,)`` onto that of ``w (B, 3)``, the shortest arc."""
+    return shortest_arc(np.broadcast_to(w0, np.shape(w)), w)
+
+
+def spine_bend_in_root(w0_in_root: np.ndarray, w: np.ndarray, root_rot: np.ndarray) -> np.ndarray:
+    """``(B, 4)`` eq. 4's bend in the root joint's frame: ``w0_in_root (3,)``, eq. 1's ``w0``
+    seen from the root's walk-in rotation (``R0(root)^-1 w0``), turned onto ``w (B, 3)`` seen
+    from the root's rotations ``root_rot (B, 4)`` (module docstring)."""
+    # R^T w by a matrix product: fewer numpy calls than quat.rotate on a tick's vectors.
+    w_in_root = (np.asarray(w)[..., None, :] @ quat.unit_to_matrix(root_rot))[..., 0, :]
+    return spine_bend(w0_in_root, w_in_root)

@@ -49,6 +49,7 @@ from avatar_models.body.ik import HumanoidIK, IKSettings, motion_from_qpos
 from avatar_models.rigs import identify_rig
 from render_cams import TrackingStream
 from render_cams.vr import FULL_BODY, Attachment, nominal_attachment
+from synthesis.avatargo.analytic_ik import AnalyticIK
 from synthesis.avatargo.calibration import Roles, classes_of, identify_roles
 from synthesis.avatargo.fingers import FingerIK
 from synthesis.avatargo.hands import (
@@ -61,7 +62,7 @@ from synthesis.avatargo.hands import (
 )
 from synthesis.avatargo.least_squares_ik import LeastSquaresIK
 from synthesis.avatargo.offsets import TrackerOffsets, exact_offsets, fixed_offsets
-from synthesis.avatargo.spine import spine_bend
+from synthesis.avatargo.spine import spine_bend, spine_bend_in_root
 from synthesis.base import (
     DEFAULT_RATE_HZ,
     FrameBatch,
@@ -97,12 +98,19 @@ ITERATIONS_PER_TICK = 2
 FIRST_ITERATIONS = 40
 """QP iterations of the first tick, from the T-pose rigidly fitted to the goals."""
 OFFSET_KINDS = ("exact", "fixed")
-SOLVERS = {"mink": HumanoidIK, "least-squares": LeastSquaresIK}
-"""Full-body IK: mink's QP (default: joint ranges as constraints) or closed-form damped
-least squares on the QP's costs (:mod:`synthesis.avatargo.least_squares_ik`: ~2.5x faster a
-tick, 2-3x the foot and root error while walking, see its docstring). The first tick, 40
-iterations from the rigidly fitted T-pose, is mink's either way (least-squares steps from
-there left a leg 45 cm off on the generator's box)."""
+QP_SOLVERS = {"mink": HumanoidIK, "least-squares": LeastSquaresIK}
+"""Full-body IK on the humanoid's goals (:data:`SITES`): mink's QP (joint ranges as
+constraints) or closed-form damped least squares on the QP's costs
+(:mod:`synthesis.avatargo.least_squares_ik`: ~2.5x faster a tick, 2-3x the foot and root
+error while walking, see its docstring). The first tick, 40 iterations from the rigidly
+fitted T-pose, is mink's either way (least-squares steps from there left a leg 45 cm off on
+the generator's box)."""
+ANALYTIC = "analytic"
+SOLVERS = (ANALYTIC, *QP_SOLVERS)
+"""The per-tick IK: ``"analytic"`` (default), the paper's Unity-IK structure
+(:mod:`synthesis.avatargo.analytic_ik`: root from eqs. 2-3, spine by eq. 4, two-bone limbs,
+no optimisation), or one of :data:`QP_SOLVERS`, full-body IK on the humanoid standing in
+for Unity's IK."""
 
 
 @dataclass(frozen=True)
@@ -168,7 +176,7 @@ class AvatarGo(Synthesizer):
             by the head's height (§3.2: the user walks into the avatar, eyes in its eyes).
         fingers: pose the fingers on the controllers (when the avatar has finger bones).
         iterations_per_tick: IK iterations per tick after the first.
-        solver: a key of :data:`SOLVERS`.
+        solver: one of :data:`SOLVERS`.
 
     Raises:
         CalibrationError: the walk-in sample does not identify the devices.
@@ -185,7 +193,7 @@ class AvatarGo(Synthesizer):
         headset: Attachment | None = None,
         fingers: bool = True,
         iterations_per_tick: int = ITERATIONS_PER_TICK,
-        solver: str = "mink",
+        solver: str = ANALYTIC,
     ):
         if offsets not in OFFSET_KINDS:
             raise SynthesisError(f"offsets must be one of {OFFSET_KINDS}, got {offsets!r}")
@@ -204,7 +212,31 @@ class AvatarGo(Synthesizer):
         self.grip: Grip = grip_of(self.body.skeleton)
         self.calibration = self._calibrate(roles, scale, head, positions, walk_in.quaternions)
         self.iterations_per_tick = int(iterations_per_tick)
-        self.ik = SOLVERS[solver](
+        self.ik: HumanoidIK | None = None
+        self.analytic: AnalyticIK | None = None
+        if solver == ANALYTIC:
+            self.analytic = AnalyticIK(self.body)
+            self._arm_length = self.analytic.arm_length
+            cal = self.calibration
+            # The head, feet and root (TRACKED) and the wrists (HANDS) in one product.
+            self._joint_offsets = TrackerOffsets(
+                np.concatenate([cal.tracked.position, cal.hands.position]),
+                np.concatenate([cal.tracked.rotation, cal.hands.rotation]),
+            )
+            self._w0_in_root = quat.rotate(quat.conj(cal.roles.heading), cal.w0)
+        else:
+            self._build_qp(QP_SOLVERS[solver])
+
+        self.finger_ik = (
+            FingerIK(self.body.skeleton, self.grip)
+            if fingers and has_fingers(self.body.skeleton)
+            else None
+        )
+        self.reset()
+
+    def _build_qp(self, solver: type[HumanoidIK]) -> None:
+        """The full-body IK of ``solver`` on :data:`SITES`, and the arms' sites."""
+        self.ik = solver(
             self.body.model,
             SITES,
             position_cost=POSITION_COST,
@@ -219,13 +251,6 @@ class AvatarGo(Synthesizer):
         self.ik.frame_positions(self.body.model.qpos0)  # the rest pose into the sites' data
         arm = self.ik.configuration.data.site_xpos[site].reshape(3, 2, 3)
         self._arm_length = np.linalg.norm(np.diff(arm, axis=0), axis=-1).sum(0)  # (2,)
-
-        self.finger_ik = (
-            FingerIK(self.body.skeleton, self.grip)
-            if fingers and has_fingers(self.body.skeleton)
-            else None
-        )
-        self.reset()
 
     # -- walk-in ----------------------------------------------------------------------------
     def _calibrate(
@@ -323,19 +348,69 @@ class AvatarGo(Synthesizer):
         return goal_pos, goal_rot
 
     def advance(self, frames: FrameBatch) -> Poses:
-        """Goals for the whole batch at once, then one warm-started IK solve per frame."""
+        """The analytic solver on the whole batch at once, or the QP solvers' goals for the
+        batch, then one warm-started solve per frame; the fingers frame by frame."""
         index = self.device_index(frames)
         ok = frames.usable()[:, index]
-        pos = _first_usable(frames.positions[:, index], ok, self._last_pos)
-        rot = _first_usable(frames.quaternions[:, index], ok, self._last_rot)
+        poses = np.concatenate([frames.positions[:, index], frames.quaternions[:, index]], -1)
+        last = np.concatenate([self._last_pos, self._last_rot], -1)
+        poses = _first_usable(poses, ok, last)  # (B, 6, 7) positions and rotations
+        pos, rot = poses[..., :3], poses[..., 3:]
         self._last_pos, self._last_rot = pos[-1], rot[-1]
         seen = np.isfinite(pos).all(-1).all(-1)  # every device tracked at least once
-        goal_pos, goal_rot = self.goals(np.nan_to_num(pos), quat.normalize(rot))
-        qpos = np.empty((frames.size, self.body.model.nq))
-        fingers = []
+        pos = np.where(seen[:, None, None], pos, 0.0)  # NaN before a device is first seen
+        rot = quat.normalize(np.where(seen[:, None, None], rot, quat.IDENTITY))
+        if self.analytic is not None:
+            root_pos, local = self._solve_analytic(pos, rot, seen)
+        else:
+            root_pos, local = self._solve_qp(pos, rot, seen)
+        if self.finger_ik is not None:
+            fingers = np.stack([self.finger_ik.advance().copy() for _ in range(frames.size)])
+            rig = self.finger_ik.rig
+            local = local.copy()
+            local[:, rig.joints] = self.finger_ik.local_rotations(fingers)
+        return Poses(root_pos, local)
+
+    def _solve_analytic(self, pos: np.ndarray, rot: np.ndarray, seen: np.ndarray):
+        """Root positions ``(B, 3)`` and local rotations ``(B, J, 4)`` by
+        :class:`~synthesis.avatargo.analytic_ik.AnalyticIK` for the role-ordered device
+        poses ``pos (B, 6, 3)``, ``rot (B, 6, 4)``; the walk-in T-pose where not ``seen``."""
+        cal = self.calibration
+        hand = [FULL_BODY.index(d) for d in HANDS]
+        devices = [FULL_BODY.index(d) for d in (*TRACKED, *HANDS)]
+        joint_pos, joint_rot = self._joint_offsets.joint_poses(pos[:, devices], rot[:, devices])
+        w = pos[:, FULL_BODY.index("hmd")] - pos[:, FULL_BODY.index("back_tracker")]
+        bend = spine_bend_in_root(self._w0_in_root, w, joint_rot[:, 3])
+        # Ankles and wrists: the goals of the four limbs (analytic_ik.LIMBS order).
+        ends = [1, 2, 4, 5]
+        solved = self.analytic.solve(
+            joint_pos[:, 3],
+            joint_rot[:, 3],
+            bend,
+            joint_rot[:, 0],
+            joint_pos[:, ends],
+            joint_rot[:, ends],
+        )
+        wrist_pos, wrist_rot = joint_pos[:, 4:], joint_rot[:, 4:]
+        wrist = solved.end_pos[:, 2:]
+        palm = palm_distance(wrist, quat.unit_to_matrix(wrist_rot), pos[:, hand], self.grip)
+        reach = out_of_reach(solved.upper_pos[:, 2:], wrist_pos, self._arm_length)
+        self.palm_distance.extend(palm[seen])
+        self.attached.extend(reach[seen])
+        if seen.all():
+            return solved.root_pos, solved.local_rot
+        t_pose = np.tile(quat.IDENTITY, (self.body.skeleton.n_joints, 1))
+        t_pose[0] = cal.roles.heading
+        root_pos = np.where(seen[:, None], solved.root_pos, cal.root_pos)
+        return root_pos, np.where(seen[:, None, None], solved.local_rot, t_pose)
+
+    def _solve_qp(self, pos: np.ndarray, rot: np.ndarray, seen: np.ndarray):
+        """As :meth:`_solve_analytic`, by one warm-started QP-solver solve per frame."""
+        goal_pos, goal_rot = self.goals(pos, rot)
+        qpos = np.empty((seen.size, self.body.model.nq))
         data = self.ik.configuration.data
         hand = [FULL_BODY.index(d) for d in HANDS]
-        for b in range(frames.size):
+        for b in range(seen.size):
             if seen[b]:
                 start, steps, solve = self._q, self.iterations_per_tick, self.ik.solve_frame
                 if not self._solved:  # the first goals may be far from the walk-in T-pose
@@ -352,15 +427,8 @@ class AvatarGo(Synthesizer):
                 shoulders = data.site_xpos[self._shoulder_sites]
                 self.attached.append(out_of_reach(shoulders, goal_pos[b, 5:], self._arm_length))
             qpos[b] = self._q
-            if self.finger_ik is not None:
-                fingers.append(self.finger_ik.advance().copy())
         motion = motion_from_qpos(self.body, qpos, DEFAULT_RATE_HZ)
-        local = motion.local_rot
-        if self.finger_ik is not None:
-            local = local.copy()
-            rig = self.finger_ik.rig
-            local[:, rig.joints] = self.finger_ik.local_rotations(np.stack(fingers))
-        return Poses(motion.root_pos, local)
+        return motion.root_pos, motion.local_rot
 
     def run(self, stream: TrackingStream) -> Motion:
         # The QPs are small: BLAS threads cost more than they save (see avatar_models.body.ik).

@@ -11,7 +11,8 @@ Clean-up, causal so that it runs in ``step()``: at the first frame of a stance t
 horizontal position becomes the anchor; while the stance lasts, the ankle's target is the
 anchor at floor height, faded in over ``BLEND_IN_S``; after lift-off the target fades back to
 the free (synthesised) ankle over ``BLEND_OUT_S``. The leg reaches the target by two-bone IK
-(:mod:`.two_bone`, hip-knee-ankle, knee pole from the synthesised pose, foot orientation kept).
+(:mod:`synthesis.two_bone`, hip-knee-ankle, knee pole from the synthesised pose, foot
+orientation kept).
 
 The state machine is recursive (each frame needs the previous one's anchor and fade), so
 batch and streaming both run :meth:`FootContact.update` frame after frame, on ``(2, 3)``

@@ -47,8 +47,8 @@ from synthesis.coolmoves.foot_contact import FootContact
 from synthesis.coolmoves.knn import K_NEIGHBOURS, MAX_DISTANCE, BothHandsKNN, PerHand
 from synthesis.coolmoves.limits import JointLimits
 from synthesis.coolmoves.smoothing import ewma
-from synthesis.coolmoves.two_bone import chain_fk
-from synthesis.coolmoves.two_bone import solve as two_bone
+from synthesis.two_bone import chain_fk
+from synthesis.two_bone import solve as two_bone
 
 _Z = np.array([0.0, 0.0, 1.0])
 EYE_HEIGHT_FRAC = 0.936
@@ -70,7 +70,7 @@ class Options:
         smooth: EWMA smoothing. clamp: joint limits.
         matcher: ``"knn"`` (the paper's method) or ``"gmm"`` (the slower mixture variant).
         arm_ik: beyond the paper, the share (0..1) by which each arm is bent with two-bone IK
-            (:mod:`.two_bone`) so that its controller point reaches the tracked controller;
+            (:mod:`synthesis.two_bone`) so that its controller point reaches the tracked controller;
             applied where that hand is tracked, after the joint limits, which are applied
             again. 0 (the default) is the paper's output: hands from the blended database
             poses only; the registered method ``coolmoves+arm-ik`` sets 1

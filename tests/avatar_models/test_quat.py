@@ -20,6 +20,25 @@ def test_mul_rotate_conj_match_scipy():
     np.testing.assert_allclose(quat.angle(qa), a.magnitude(), atol=1e-12)
 
 
+def test_small_and_large_products_agree_to_the_bit():
+    """A step's few quaternions (the outer-product form) and a clip's (the component form,
+    above ``SMALL_PRODUCT``) give the same bits, as ``step`` must give what ``run`` gives;
+    both match scipy."""
+    rng = np.random.default_rng(1)
+    a, b = Rotation.random(2000, random_state=rng), Rotation.random(2000, random_state=rng)
+    qa, qb = quat.from_scipy(a), quat.from_scipy(b)
+    assert qa.size + qb.size > quat.SMALL_PRODUCT
+    whole = quat.mul(qa, qb)
+    np.testing.assert_allclose(quat.to_matrix(whole), (a * b).as_matrix(), atol=1e-12)
+    for rows in (slice(0, 1), slice(5, 9), slice(10, 60)):
+        assert np.array_equal(quat.mul(qa[rows], qb[rows]), whole[rows])
+    # Broadcast shapes too: one rotation against many, a grid of pairs.
+    assert np.array_equal(quat.mul(qa[0], qb[:7]), quat.mul(np.tile(qa[0], (300, 1)), qb[:300])[:7])
+    grid = quat.mul(qa[:3, None], qb[None, :5])  # (3, 5, 4)
+    pairs = quat.mul(np.tile(np.repeat(qa[:3], 5, 0), (20, 1)), np.tile(qb[:5], (60, 1)))
+    assert np.array_equal(grid.reshape(15, 4), pairs[:15])
+
+
 def test_power_is_scipy_slerp_step():
     rng = np.random.default_rng(4)
     a, b = Rotation.random(40, random_state=rng), Rotation.random(40, random_state=rng)

@@ -13,8 +13,8 @@ from synthesis.base import TrackingFrame
 from synthesis.coolmoves import CoolMoves, Options, build_database
 from synthesis.coolmoves.accuracy import stance_skating_cm_s
 from synthesis.coolmoves.database import driver_positions
-from synthesis.coolmoves.two_bone import chain_fk, solve
 from synthesis.scoring import body17_errors_cm, hand_correlation
+from synthesis.two_bone import chain_fk, solve
 from tests.synthesis.conftest import TEST_SUBJECT
 
 

@@ -1,20 +1,23 @@
 """Analytic two-bone inverse kinematics (shoulder-elbow-wrist, hip-knee-ankle) on local rotations.
 
-Beyond the paper: CoolMoves outputs blended database poses; this module moves a limb's end
-joint to a target with the closed-form two-bone solution (law of cosines), as used for arm
-and leg IK in games (e.g. Unity's TwoBoneIKConstraint):
+Shared by the methods: CoolMoves' hand and foot corrections (beyond that paper, which outputs
+blended database poses) and AvatarGo's limbs (:mod:`synthesis.avatargo.analytic_ik`, the
+paper's Unity IK). It moves a limb's end joint to a target with the closed-form two-bone
+solution (law of cosines), as used for arm and leg IK in games (e.g. Unity's
+TwoBoneIKConstraint):
 
 - the middle joint (elbow, knee) bends about the normal of its current bend plane, i.e. its
   hinge, until root and end are as far apart as root and target (clipped to the reachable
   range ``[|l1 - l2|, l1 + l2]``): a hinge joint stays a hinge, inside its limits;
 - the whole limb then swings at the root by the smallest rotation taking the end onto the
   target, so the bend plane (the elbow or knee pole) is the input pose's, turned as little as
-  possible: the blended database pose decides where the elbow points;
+  possible: the input pose (CoolMoves: the blended database pose) decides where the elbow
+  points;
 - the end joint keeps its global orientation (hand or foot do not tilt).
 
 Vectorised over ``B`` poses and ``S`` limbs (both arms in one pass). Forward kinematics
 along the chains (:func:`chain_fk`) with numpy matrices: the hot path of ``step()``
-cannot afford scipy objects (see :mod:`.rotations`).
+cannot afford scipy ``Rotation`` objects (tens of microseconds each).
 """
 
 from __future__ import annotations
@@ -68,15 +71,15 @@ def _unit(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return v / np.maximum(norm, _EPS), norm[..., 0]
 
 
-def _arc(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def shortest_arc(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``(..., 4)`` smallest rotations turning directions ``a`` onto ``b`` ``(..., 3)``."""
     a, _ = _unit(a)
     b, _ = _unit(b)
     q = np.concatenate([1.0 + np.sum(a * b, axis=-1, keepdims=True), _cross(a, b)], axis=-1)
-    # Antiparallel directions never occur between a bone and its corrected self; guard anyway.
-    return np.where(q[..., :1] > _EPS, q, quat.IDENTITY) / np.maximum(
-        np.linalg.norm(q, axis=-1, keepdims=True), _EPS
-    )
+    # Antiparallel directions (a bone onto its reverse, a back bent double) have no single
+    # shortest arc: identity there, as for parallel ones.
+    q = np.where(q[..., :1] > _EPS, q, quat.IDENTITY)
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
 def _in_frame(q: np.ndarray, frame: np.ndarray) -> np.ndarray:
@@ -120,7 +123,7 @@ def solve(
     turn_lower = quat.from_axis_angle(normal, np.arccos(cos_bend) - bend_now)
     new_c = b + quat.rotate(turn_lower, c - b)
     # 2. Swing the whole limb at the root, by the smallest rotation, onto the target.
-    turn_upper = _arc(new_c - a, target - a)
+    turn_upper = shortest_arc(new_c - a, target - a)
     i, j, k = np.moveaxis(np.asarray(joints), -1, 0)
     # The end joint keeps its global rotation: undo both turns in the old middle frame.
     both = quat.mul(turn_upper, turn_lower)

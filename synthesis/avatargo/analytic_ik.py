@@ -1,0 +1,237 @@
+"""AvatarGo's per-tick IK as the paper's Unity IK (§3.4): closed form, no optimisation.
+
+§3.4 drives the avatar with Unity's built-in IK: end effectors at the wrists and ankles
+(analytic two-bone limbs), the root placed from the back tracker (eqs. 2-3), the spine
+inclined by forward kinematics by ``alpha_t = angle(w0, w_t)`` (eq. 4) and the head turned
+as the headset. :class:`AnalyticIK` is that structure on the avatar's skeleton, each tick:
+
+1. **root**: the pelvis joint at its goal position and rotation (eqs. 2-3 of the back
+   tracker); the skeleton's root carries it (the joints between them keep their rest);
+2. **spine**: eq. 4's bend (:func:`~synthesis.avatargo.spine.spine_bend_in_root`) spread
+   evenly over the spine joints between pelvis and neck, the neck straight;
+3. **head**: its rotation from the headset through its exact offset; its position follows
+   by forward kinematics (it is not a goal of Unity's IK either);
+4. **legs and arms**: two-bone IK (:func:`synthesis.two_bone.solve`) of hip-knee-ankle onto
+   the ankle's goal (eq. 2) and of shoulder-elbow-wrist onto the wrist's goal under the
+   controller (:mod:`synthesis.avatargo.hands`). Bend planes (the pole of Unity's
+   TwoBoneIK): each middle joint is pre-bent from the T-pose about its hinge (the shank
+   backwards, the forearm forwards, :data:`BEND_TOWARD`), the thigh first turned about the
+   leg by the foot's twist (the knee over the toes), and the limb swung by the smallest
+   rotation onto its goal: knees point where the pelvis and feet face, elbows down and back
+   for hands held in front;
+5. **ankles and wrists**: their rotations set to their goals (eq. 3; the controller's
+   rotation through the palm offset), so the palm sits on the controller wherever the
+   wrist reaches its goal.
+
+Joint ranges: the knees' and elbows' flexion stays within the humanoid's hinge range
+(:func:`flexion_limit`; a goal nearer than that bend allows leaves the end short of it),
+and a goal beyond the limb's length leaves the limb straight, pointing at it (the hand is
+then reported out of reach, :func:`~synthesis.avatargo.hands.out_of_reach`). Hips,
+shoulders, spine, head, ankles and wrists are not limited: their rotations are the user's
+own (trackers, eq. 3), within the user's range; where an avatar of other proportions puts
+one out of the humanoid's range, the physics check (``joint_limit_violation_frac``) shows it,
+as it would of Unity's IK.
+
+Per tick this is a fixed, small amount of numpy on ``(B, 4, ...)`` arrays, vectorised over
+the ``B`` frames of a batch (nothing carries over between frames) and over the four limbs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from avatar_models import quat
+from avatar_models.body import BodyDescription
+from synthesis.two_bone import solve as two_bone
+
+LIMBS = (
+    ("l_hip", "l_knee", "l_ankle"),
+    ("r_hip", "r_knee", "r_ankle"),
+    ("l_shoulder", "l_elbow", "l_wrist"),
+    ("r_shoulder", "r_elbow", "r_wrist"),
+)
+"""The four two-bone limbs (body17 joints: upper, middle, end), legs first."""
+LEGS = 2
+BEND_TOWARD = np.array([[-1.0, 0.0, 0.0]] * 2 + [[1.0, 0.0, 0.0]] * 2)
+"""``(4, 3)`` where each middle joint's lower bone turns when it flexes, in the rest frame
+(facing +X): the shank backwards, the forearm forwards. The hinge is the lower bone crossed
+with it (:meth:`AnalyticIK.hinges`)."""
+PRE_BEND_RAD = 0.2
+"""The pre-bend that gives each straight rest limb its bend plane; the two-bone solve then
+sets the bend itself (any angle well away from 0 and pi gives the same result)."""
+
+
+@dataclass(frozen=True, eq=False)
+class AnalyticPose:
+    """One batch solved by :meth:`AnalyticIK.solve`.
+
+    Attributes:
+        root_pos: ``(B, 3)`` the skeleton's root joint, world metres.
+        local_rot: ``(B, J, 4)`` wxyz local rotations of the skeleton's joints.
+        upper_pos: ``(B, 4, 3)`` hips and shoulders (:data:`LIMBS` order).
+        end_pos: ``(B, 4, 3)`` where ankles and wrists ended (their goals where reachable).
+    """
+
+    root_pos: np.ndarray
+    local_rot: np.ndarray
+    upper_pos: np.ndarray
+    end_pos: np.ndarray
+
+
+def path_between(parents, ancestor: int, joint: int) -> list[int]:
+    """Joints from ``ancestor`` (excluded) down to ``joint`` (included)."""
+    path = []
+    while joint != ancestor:
+        if joint < 0:
+            raise ValueError(f"joint {joint} is not below {ancestor}")
+        path.append(joint)
+        joint = parents[joint]
+    return path[::-1]
+
+
+def flexion_limit(model: mujoco.MjModel, body: str, hinge: np.ndarray) -> float:
+    """Largest flexion (radians) about ``hinge (3,)`` (rest frame) that the humanoid's hinge
+    joints of ``body`` allow: the range end of the hinge most parallel to it, on its side;
+    pi where the body has no limited hinge about that axis."""
+    body_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, body)
+    joints = np.flatnonzero(
+        (model.jnt_bodyid == body_id)
+        & (model.jnt_type == mujoco.mjtJoint.mjJNT_HINGE)
+        & model.jnt_limited.astype(bool)
+    )
+    if body_id < 0 or joints.size == 0:
+        return np.pi
+    along = model.jnt_axis[joints] @ hinge
+    k = int(np.argmax(np.abs(along)))
+    if abs(along[k]) < 0.9:  # no hinge about this axis
+        return np.pi
+    low, high = model.jnt_range[joints[k]]
+    return float(high if along[k] > 0 else -low)
+
+
+class AnalyticIK:
+    """The paper's Unity-IK structure on ``body``'s skeleton (module docstring).
+
+    The skeleton's rest pose must be the avatar's T-pose facing +X (the walk-in pose, as
+    every rig :func:`~avatar_models.body.build_body` accepts), with the pelvis, spine, neck,
+    head and limbs of its body17 map on one chain each.
+    """
+
+    def __init__(self, body: BodyDescription):
+        sk, body17 = body.skeleton, body.rig.body17
+        self.n_joints = sk.n_joints
+        parents = np.asarray(sk.parents)
+        rest = sk.rest_positions()
+        self.pelvis = sk.index(body17["pelvis"])
+        neck, head = sk.index(body17["neck"]), sk.index(body17["head"])
+        self.head = head
+        spine = path_between(parents, self.pelvis, neck)
+        self.spine = np.array(spine[:-1] or spine)  # the neck itself only if nothing between
+        self.root_to_pelvis = rest[self.pelvis] - rest[0]
+        anchors = [0, *self.spine]  # the joints whose rotation the spine's bend sets
+        self.spine_shares = np.arange(len(anchors)) / len(self.spine)  # (S + 1,) of the bend
+        self.spine_offsets = rest[self.spine] - rest[anchors[:-1]]  # (S, 3)
+        limbs = np.array([[sk.index(body17[j]) for j in limb] for limb in LIMBS])  # (4, 3)
+        self.limbs = limbs
+
+        def anchor_of(joint: int) -> int:
+            """Index in ``anchors`` of the nearest strict ancestor of ``joint`` there."""
+            j = parents[joint]
+            while j not in anchors:
+                j = parents[j]
+            return anchors.index(j)
+
+        self.upper_anchor = np.array([anchor_of(j) for j in limbs[:, 0]])
+        self.head_anchor = anchor_of(head)
+        self.upper_offsets = rest[limbs[:, 0]] - rest[np.array(anchors)[self.upper_anchor]]
+        self.upper_bones = rest[limbs[:, 1]] - rest[limbs[:, 0]]  # (4, 3)
+        self.lower_bones = rest[limbs[:, 2]] - rest[limbs[:, 1]]
+        self.hinges = np.cross(self.lower_bones, BEND_TOWARD)
+        self.hinges /= np.linalg.norm(self.hinges, axis=-1, keepdims=True)
+        self.pre_bend = quat.from_axis_angle(self.hinges, np.full(len(LIMBS), PRE_BEND_RAD))
+        self.leg_axes = (self.upper_bones + self.lower_bones)[:LEGS]
+        self.leg_axes /= np.linalg.norm(self.leg_axes, axis=-1, keepdims=True)
+        l1 = np.linalg.norm(self.upper_bones, axis=-1)
+        l2 = np.linalg.norm(self.lower_bones, axis=-1)
+        knees_elbows = zip(limbs[:, 1], self.hinges, strict=True)
+        flexion = np.array([flexion_limit(body.model, sk.names[j], h) for j, h in knees_elbows])
+        # The nearest reach: the law of cosines at the largest flexion (straight limbs at
+        # rest: the flexion is the angle between the bones).
+        self.reach = np.stack(
+            [np.sqrt(l1**2 + l2**2 + 2 * l1 * l2 * np.cos(flexion)), l1 + l2], axis=-1
+        )  # (4, 2) nearest, farthest
+        template = np.tile(quat.IDENTITY, (sk.n_joints, 1))
+        template[limbs[:, 1]] = self.pre_bend
+        self.template = template
+
+    @property
+    def arm_length(self) -> np.ndarray:
+        """``(2,)`` shoulder to wrist, left and right arm, straight."""
+        return self.reach[LEGS:, 1]
+
+    def solve(
+        self,
+        pelvis_pos: np.ndarray,
+        pelvis_rot: np.ndarray,
+        spine_bend: np.ndarray,
+        head_rot: np.ndarray,
+        end_pos: np.ndarray,
+        end_rot: np.ndarray,
+    ) -> AnalyticPose:
+        """The pose of ``B`` frames from their goals (world frame, wxyz unit quaternions).
+
+        Args:
+            pelvis_pos, pelvis_rot: ``(B, 3)``, ``(B, 4)`` the pelvis joint (eqs. 2-3).
+            spine_bend: ``(B, 4)`` the whole spine's bend in the pelvis frame (eq. 4).
+            head_rot: ``(B, 4)`` the head joint's world rotation.
+            end_pos, end_rot: ``(B, 4, 3)``, ``(B, 4, 4)`` ankles' and wrists' goals
+                (:data:`LIMBS` order).
+        """
+        b = pelvis_pos.shape[0]
+        # Forward kinematics down the spine, each spine joint turned by an equal share of
+        # the bend: the world rotations of the root and the spine joints ("anchors": every
+        # other joint hangs from one of them unrotated), as quaternions for the outputs and
+        # as matrices for the positions (one matrix product each; numpy's per-call overhead,
+        # not the arithmetic, is the cost of these few vectors).
+        share = quat.power(spine_bend[:, None], self.spine_shares)  # (B, S + 1, 4)
+        glob = quat.mul(pelvis_rot[:, None], share)
+        mats = quat.unit_to_matrix(glob)  # (B, S + 1, 3, 3)
+        root_pos = pelvis_pos - (mats[:, 0] @ self.root_to_pelvis)
+        steps = (mats[:, :-1] @ self.spine_offsets[..., None])[..., 0]  # (B, S, 3)
+        pos = root_pos[:, None] + np.concatenate([np.zeros((b, 1, 3)), steps], 1).cumsum(1)
+
+        local = np.repeat(self.template[None], b, axis=0)
+        local[:, 0] = pelvis_rot
+        local[:, self.spine] = share[:, 1:2]
+        local[:, self.head] = quat.mul(quat.conj(glob[:, self.head_anchor]), head_rot)
+
+        parent = glob[:, self.upper_anchor]  # (B, 4, 4) hips' and shoulders' parents
+        parent_mat = mats[:, self.upper_anchor]
+        upper_pos = pos[:, self.upper_anchor] + (parent_mat @ self.upper_offsets[..., None])[..., 0]
+        # Knee over the toes: the thigh turned about the leg by the foot's twist about it.
+        foot = quat.mul(quat.conj(parent[:, :LEGS]), end_rot[:, :LEGS])  # in the hip's parent
+        along = np.sum(foot[..., 1:] * self.leg_axes, axis=-1, keepdims=True)
+        twist = np.concatenate([foot[..., :1], along * self.leg_axes], axis=-1)
+        twist /= np.linalg.norm(twist, axis=-1, keepdims=True)
+        local[:, self.limbs[:LEGS, 0]] = twist
+        upper_rot = np.concatenate([twist, np.broadcast_to(quat.IDENTITY, (b, 2, 4))], axis=1)
+        upper = quat.mul(parent, upper_rot)
+        limb_mats = quat.unit_to_matrix(np.stack([upper, quat.mul(upper, self.pre_bend)], 2))
+        middle_pos = upper_pos + (limb_mats[:, :, 0] @ self.upper_bones[..., None])[..., 0]
+        end_now = middle_pos + (limb_mats[:, :, 1] @ self.lower_bones[..., None])[..., 0]
+        globs = np.concatenate([parent_mat[:, :, None], limb_mats, limb_mats[:, :, 1:]], 2)
+        chain_pos = np.stack([upper_pos, upper_pos, middle_pos, end_now], axis=2)
+        # Goals nearer than the flexion limit or beyond the limb's length: the reachable
+        # point on the way to the goal.
+        reach = end_pos - upper_pos
+        dist = np.linalg.norm(reach, axis=-1, keepdims=True)
+        clipped = np.clip(dist, self.reach[:, :1], self.reach[:, 1:])
+        target = upper_pos + reach * (clipped / np.maximum(dist, 1e-12))
+        local = two_bone(local, globs, chain_pos, self.limbs, target)
+        limb = self.limbs
+        middle = quat.mul(quat.mul(parent, local[:, limb[:, 0]]), local[:, limb[:, 1]])
+        local[:, limb[:, 2]] = quat.mul(quat.conj(middle), end_rot)
+        return AnalyticPose(root_pos, local, upper_pos, target)
