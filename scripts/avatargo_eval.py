@@ -21,6 +21,7 @@ from sim.humanoid import humanoid_for
 from sim.plausibility import CONTRACT_KEYS, check_humanoid
 from sim.thresholds import CheckConfig
 from synthesis.avatargo.study import EFFECTORS, sample_user, study_run
+from synthesis.avatargo.synthesizer import ANALYTIC
 from synthesis.evaluate import Trial
 
 VARIANTS = ("exact", "fixed")
@@ -28,13 +29,14 @@ BUILTIN_ACTIVITIES = ("wave", "box", "walk")
 """Built-in motions of the study: standing (the leg artefact shows), arms busy, and walking."""
 
 
-def run_user(trial: Trial, duration_s: float, checks: CheckConfig) -> dict:
-    """One trial's row: the user, and per variant the study's scores and physics values."""
+def run_user(trial: Trial, duration_s: float, checks: CheckConfig, solver: str = ANALYTIC) -> dict:
+    """One trial's row: the user, and per variant the study's scores and physics values,
+    AvatarGo's per-tick IK by ``solver`` (:data:`~synthesis.avatargo.synthesizer.SOLVERS`)."""
     truth = trial.motion
     frames = int(round(duration_s * truth.fps)) + 1
     truth = humanoid_for(truth[: min(frames, truth.n_frames)]).motion
     user = sample_user(trial.seed, truth.skeleton)
-    result = study_run(truth, user, REALISTIC_NOISE)
+    result = study_run(truth, user, REALISTIC_NOISE, solver=solver)
     row = {"trial": trial.name, "class": trial.cls, "user": result["user"]}
     for kind in VARIANTS:
         physics = check_humanoid(humanoid_for(result["motions"][kind]), checks).values
@@ -77,15 +79,17 @@ def run_avatargo_eval(
     duration_s: float,
     checks: CheckConfig | None = None,
     progress: Callable[[int, int, str], None] | None = None,
+    solver: str = ANALYTIC,
 ) -> dict:
-    """The study over ``trials`` (one simulated user each), first ``duration_s`` of each."""
+    """The study over ``trials`` (one simulated user each), first ``duration_s`` of each,
+    with AvatarGo's per-tick IK by ``solver``."""
     checks = checks or CheckConfig()
     rows = []
     for i, trial in enumerate(trials):
-        rows.append(run_user(trial, duration_s, checks))
+        rows.append(run_user(trial, duration_s, checks, solver))
         if progress is not None:
             progress(i + 1, len(trials), trial.name)
-    return {"method": "avatargo", "users": rows, "overall": summarise(rows)}
+    return {"method": "avatargo", "solver": solver, "users": rows, "overall": summarise(rows)}
 
 
 def write_plot(results: dict, path: Path) -> Path:

@@ -112,7 +112,9 @@ def write_leaderboard(board: dict, out: Path, json_out: Path | None) -> None:
 def _avatargo_table(results: dict) -> Table:
     from synthesis.avatargo.study import EFFECTORS
 
-    table = Table(title=f"avatargo, {len(results['users'])} simulated users (exact / fixed)")
+    table = Table(
+        title=f"avatargo ({results.get('solver', 'analytic')} IK), {len(results['users'])} simulated users (exact / fixed)"
+    )
     columns = [f"effector_err_cm.{k}" for k in EFFECTORS] + [
         "knee_err_deg",
         "palm_cm",
@@ -320,6 +322,13 @@ def register(app: typer.Typer) -> None:
         mocap: Annotated[
             Path | None, typer.Option(help="controllerpose: also held-out real clips here.")
         ] = None,
+        solver: Annotated[
+            str,
+            typer.Option(
+                help="avatargo: per-tick IK, analytic (the paper's Unity IK), mink or "
+                "least-squares."
+            ),
+        ] = "analytic",
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
     ) -> None:
@@ -380,6 +389,13 @@ def register(app: typer.Typer) -> None:
                 "avatargo, movebox"
             )
         wanted = None if classes is None else [c.strip() for c in classes.split(",") if c.strip()]
+        if method == "avatargo":
+            from synthesis.avatargo.synthesizer import SOLVERS
+
+            if solver not in SOLVERS:
+                raise EvaluationError(
+                    f"--solver must be one of {', '.join(SOLVERS)}, got {solver!r}"
+                )
         if method == "avatargo" and wanted is None and library == "builtin":
             wanted = list(BUILTIN_ACTIVITIES[:1] if quick else BUILTIN_ACTIVITIES)
         if quick:
@@ -408,7 +424,7 @@ def register(app: typer.Typer) -> None:
                 err_console.print(f"fold {done}/{total} done: {escape(label)}")
 
             if method == "avatargo":
-                results = run_avatargo_eval(trials, duration, progress=progress)
+                results = run_avatargo_eval(trials, duration, progress=progress, solver=solver)
                 results.update(library=library, seed=seed, quick=quick, class_by=class_by)
                 write_avatargo(results, out, json_out)
                 return

@@ -30,7 +30,7 @@ from avatar_models import Motion, Skeleton, quat
 from avatar_models.body import build_body
 from avatar_models.rigs import identify_rig
 from render_cams.vr import FULL_BODY, Attachment, NoiseModel, VRSetup, nominal_attachment
-from synthesis.avatargo.synthesizer import AvatarGo
+from synthesis.avatargo.synthesizer import ANALYTIC, AvatarGo
 from synthesis.avatargo.walk_in import t_pose, walk_in
 
 LIMB_SPREAD = 0.10
@@ -164,11 +164,11 @@ def study_run(
     user: SimulatedUser,
     noise: tuple[NoiseModel, ...] = (),
     fingers: bool = True,
-    solver: str = "mink",
+    solver: str = ANALYTIC,
 ) -> dict:
     """``truth`` performed by ``user`` wearing the six devices with ``noise``; AvatarGo with
     exact and with fixed offsets on the user's avatar, its IK by ``solver``
-    (:data:`~synthesis.avatargo.synthesizer.SOLVERS`). Returns per variant :func:`score`
+    (one of :data:`~synthesis.avatargo.synthesizer.SOLVERS`). Returns per variant :func:`score`
     (the outputs under ``"motions"``)."""
     if truth.fps != 90.0:
         truth = truth.resample(90.0)  # the output's clock, frame for frame
