@@ -2,30 +2,35 @@
 
 Input: a sampled user (:mod:`synthesis.avatargo.study`) waving for 4 s (2 s in ``quick``
 mode) with the six devices and realistic VR noise. Latency is the wall time of each
-``step()`` call with BLAS on one thread and the process pinned to one CPU where the OS
-allows; the load average is in the note (the machine is shared). Rows: the whole step of
-``avatargo`` with each IK solver (:data:`~synthesis.avatargo.synthesizer.SOLVERS`; aim: p99
-under 1 ms, issue 13), against the IK baseline ``ik`` in the same process; then the parts
-of one AvatarGo tick, timed alone: the goals (eqs. 2-4, hands), each solver's IK, and one
-step of the finger IK (numeric gradient, eq. 7), which a settled hand skips.
+``step()`` call, and apart the CPU time it took (``time.thread_time``: what a loaded
+machine's other processes do not inflate by preemption), with BLAS on one thread and the
+process pinned to one CPU where the OS allows; the load average is in the note (the machine
+is shared). Rows: the whole step of ``avatargo`` with each per-tick IK
+(:data:`~synthesis.avatargo.synthesizer.SOLVERS`: the analytic Unity-IK structure, mink,
+least squares; aim: p99 under 1 ms, issue 13), against the IK baseline ``ik`` in the same
+process; then the parts of one AvatarGo tick, timed alone (best of many): the QP solvers'
+goals (eqs. 2-4, hands) and IK, the analytic solver's goals and solve, and one step of the
+finger IK (numeric gradient, eq. 7), which a settled hand skips.
 The paper (§5) reports no latency; the 90 Hz frame (11.1 ms) is the hard budget.
 """
 
 from __future__ import annotations
 
 import os
+import time
 from contextlib import contextmanager
 
 import numpy as np
 from threadpoolctl import threadpool_limits
 
+from avatar_models import quat
 from avatar_models.generator import generate, sample_subject
 from render_cams.vr import FULL_BODY
 from scripts.benchmarks import BenchRow, best_of
 from scripts.stages.devices import REALISTIC_NOISE
 from synthesis.avatargo import AvatarGo
 from synthesis.avatargo.study import sample_user, setup_for
-from synthesis.avatargo.synthesizer import ITERATIONS_PER_TICK, SOLVERS
+from synthesis.avatargo.synthesizer import ANALYTIC, ITERATIONS_PER_TICK, QP_SOLVERS, SOLVERS
 from synthesis.avatargo.walk_in import walk_in
 from synthesis.base import FrameBatch, on_clock
 from synthesis.ik_baseline import IKBaseline
@@ -57,29 +62,35 @@ def run(quick: bool = False) -> list[BenchRow]:
     stream = setup.sample(truth, seed=user.seed)
     sample = walk_in(setup, truth, user.seed, user.heading_rad)
     synths = {solver: AvatarGo(truth.skeleton, sample, solver=solver) for solver in SOLVERS}
-    synth = synths["mink"]
+    mink, analytic = synths["mink"], synths[ANALYTIC]
     baseline = IKBaseline(truth.skeleton, None)
     clocked = on_clock(stream)
     batch = FrameBatch.of_stream(clocked)
-    index = synth.device_index(batch)
-    pos, rot = clocked.positions[-1:, index], clocked.quaternions[-1:, index]
+    index = mink.device_index(batch)
+    pos, rot = clocked.positions[-1:, index], quat.normalize(clocked.quaternions[-1:, index])
     with one_core():
         lat = {solver: step_latencies_ms(s, stream) for solver, s in synths.items()}
+        cpu = {
+            solver: step_latencies_ms(s, stream, time.thread_time) for solver, s in synths.items()
+        }
         ik_lat = step_latencies_ms(baseline, stream)
-        goals_s = best_of(lambda: synth.goals(pos, rot), repeat=50)
-        goal_pos, goal_rot = synth.goals(pos, rot)
+        goals_s = best_of(lambda: mink.goals(pos, rot), repeat=50)
+        goal_pos, goal_rot = mink.goals(pos, rot)
         solve_s = {}
-        fit = synth.ik.fitted_root(goal_pos[0])
-        warm, _, _ = synth.ik.solve_frame(goal_pos[0], fit, goal_rot[0], 40)  # meets the goals
-        for solver, s in synths.items():
+        fit = mink.ik.fitted_root(goal_pos[0])
+        warm, _, _ = mink.ik.solve_frame(goal_pos[0], fit, goal_rot[0], 40)  # meets the goals
+        for solver in QP_SOLVERS:
             solve_s[solver] = best_of(
-                lambda s=s, q=warm: s.ik.solve_frame(
+                lambda s=synths[solver], q=warm: s.ik.solve_frame(
                     goal_pos[0], q, goal_rot[0], ITERATIONS_PER_TICK
                 ),
                 repeat=20,
             )
-        synth.finger_ik.reset()
-        fingers_s = best_of(lambda: synth.finger_ik.iterate(1), repeat=50)
+        analytic_goals_s = best_of(lambda: analytic.analytic_goals(pos, rot), repeat=50)
+        goals = analytic.analytic_goals(pos, rot)
+        analytic_s = best_of(lambda: analytic.analytic.solve(*goals), repeat=50)
+        mink.finger_ik.reset()
+        fingers_s = best_of(lambda: mink.finger_ik.iterate(1), repeat=50)
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     note = (
         f"{stream.n_samples} frames, {len(FULL_BODY)} devices, realistic noise, one core, "
@@ -89,13 +100,17 @@ def run(quick: bool = False) -> list[BenchRow]:
     rows = []
     for solver, values in lat.items():
         p50, p99 = (float(np.percentile(values, q)) for q in (50, 99))
+        cpu50, cpu99 = (float(np.percentile(cpu[solver], q)) for q in (50, 99))
         name = f"avatargo ({solver}) step"
         rows += [
             BenchRow(f"{name} p50", "ms", p50, AIM_MS, "issue 13 aim (1 ms)", note),
             BenchRow(f"{name} p99", "ms", p99, AIM_MS, "issue 13 aim (1 ms)", note),
+            BenchRow(f"{name} CPU time p50", "ms", cpu50, AIM_MS, "issue 13 aim (1 ms)", note),
+            BenchRow(f"{name} CPU time p99", "ms", cpu99, AIM_MS, "issue 13 aim (1 ms)", note),
             BenchRow(f"{name} p99 vs ik", "ms", p99, ik_p99, "ik baseline step p99", note),
         ]
     p50 = float(np.percentile(lat["mink"], 50))
+    a50 = float(np.percentile(lat[ANALYTIC], 50))
     it = f"{ITERATIONS_PER_TICK} iterations"
     return [
         *rows,
@@ -106,6 +121,20 @@ def run(quick: bool = False) -> list[BenchRow]:
                 f"avatargo {solver} IK, {it} (warm)", "ms", 1e3 * t, p50, "avatargo (mink) p50"
             )
             for solver, t in solve_s.items()
+        ),
+        BenchRow(
+            "avatargo analytic goals (eqs. 2-4)",
+            "ms",
+            1e3 * analytic_goals_s,
+            a50,
+            "avatargo (analytic) p50",
+        ),
+        BenchRow(
+            "avatargo analytic IK (root, spine, 4 two-bone limbs)",
+            "ms",
+            1e3 * analytic_s,
+            a50,
+            "avatargo (analytic) p50",
         ),
         BenchRow(
             "avatargo finger IK probe step (a settled hand skips it)",

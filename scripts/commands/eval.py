@@ -112,9 +112,8 @@ def write_leaderboard(board: dict, out: Path, json_out: Path | None) -> None:
 def _avatargo_table(results: dict) -> Table:
     from synthesis.avatargo.study import EFFECTORS
 
-    table = Table(
-        title=f"avatargo ({results.get('solver', 'analytic')} IK), {len(results['users'])} simulated users (exact / fixed)"
-    )
+    solver, users = results.get("solver", "analytic"), len(results["users"])
+    table = Table(title=f"avatargo ({solver} IK), {users} simulated users (exact / fixed)")
     columns = [f"effector_err_cm.{k}" for k in EFFECTORS] + [
         "knee_err_deg",
         "palm_cm",

@@ -7,8 +7,11 @@ as the headset. :class:`AnalyticIK` is that structure on the avatar's skeleton, 
 
 1. **root**: the pelvis joint at its goal position and rotation (eqs. 2-3 of the back
    tracker); the skeleton's root carries it (the joints between them keep their rest);
-2. **spine**: eq. 4's bend (:func:`~synthesis.avatargo.spine.spine_bend_in_root`) spread
-   evenly over the spine joints between pelvis and neck, the neck straight;
+2. **spine**: eq. 4's bend (:func:`~synthesis.avatargo.spine.spine_bend_in_root`) applied
+   to "the spine joint" (§3.4), the first above the pelvis; the rest of the back and the
+   neck keep their rest, so the upper body turns rigidly about it and the root-to-head line
+   turns by ``alpha_t`` (spread evenly over the three spine joints of the avatar rig, the
+   head under-turned: built-in study head error 3.5 cm);
 3. **head**: its rotation from the headset through its exact offset; its position follows
    by forward kinematics (it is not a goal of Unity's IK either);
 4. **legs and arms**: two-bone IK (:func:`synthesis.two_bone.solve`) of hip-knee-ankle onto
@@ -39,6 +42,7 @@ the ``B`` frames of a batch (nothing carries over between frames) and over the f
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import mujoco
 import numpy as np
@@ -62,6 +66,26 @@ with it (:meth:`AnalyticIK.hinges`)."""
 PRE_BEND_RAD = 0.2
 """The pre-bend that gives each straight rest limb its bend plane; the two-bone solve then
 sets the bend itself (any angle well away from 0 and pi gives the same result)."""
+
+
+class AnalyticGoals(NamedTuple):
+    """The goals of ``B`` frames (world frame, wxyz unit quaternions), in the argument order
+    of :meth:`AnalyticIK.solve`.
+
+    Attributes:
+        pelvis_pos, pelvis_rot: ``(B, 3)``, ``(B, 4)`` the pelvis joint (eqs. 2-3).
+        spine_bend: ``(B, 4)`` the whole spine's bend in the pelvis frame (eq. 4).
+        head_rot: ``(B, 4)`` the head joint's world rotation.
+        end_pos, end_rot: ``(B, 4, 3)``, ``(B, 4, 4)`` ankles' and wrists' goals
+            (:data:`LIMBS` order).
+    """
+
+    pelvis_pos: np.ndarray
+    pelvis_rot: np.ndarray
+    spine_bend: np.ndarray
+    head_rot: np.ndarray
+    end_pos: np.ndarray
+    end_rot: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
@@ -128,12 +152,10 @@ class AnalyticIK:
         self.pelvis = sk.index(body17["pelvis"])
         neck, head = sk.index(body17["neck"]), sk.index(body17["head"])
         self.head = head
-        spine = path_between(parents, self.pelvis, neck)
-        self.spine = np.array(spine[:-1] or spine)  # the neck itself only if nothing between
+        self.spine = path_between(parents, self.pelvis, neck)[0]  # "the spine joint" (§3.4)
         self.root_to_pelvis = rest[self.pelvis] - rest[0]
-        anchors = [0, *self.spine]  # the joints whose rotation the spine's bend sets
-        self.spine_shares = np.arange(len(anchors)) / len(self.spine)  # (S + 1,) of the bend
-        self.spine_offsets = rest[self.spine] - rest[anchors[:-1]]  # (S, 3)
+        anchors = [0, self.spine]  # the joints whose rotation the spine's bend sets
+        self.root_to_spine = rest[self.spine] - rest[0]
         limbs = np.array([[sk.index(body17[j]) for j in limb] for limb in LIMBS])  # (4, 3)
         self.limbs = limbs
 
@@ -181,31 +203,20 @@ class AnalyticIK:
         end_pos: np.ndarray,
         end_rot: np.ndarray,
     ) -> AnalyticPose:
-        """The pose of ``B`` frames from their goals (world frame, wxyz unit quaternions).
-
-        Args:
-            pelvis_pos, pelvis_rot: ``(B, 3)``, ``(B, 4)`` the pelvis joint (eqs. 2-3).
-            spine_bend: ``(B, 4)`` the whole spine's bend in the pelvis frame (eq. 4).
-            head_rot: ``(B, 4)`` the head joint's world rotation.
-            end_pos, end_rot: ``(B, 4, 3)``, ``(B, 4, 4)`` ankles' and wrists' goals
-                (:data:`LIMBS` order).
-        """
+        """The pose of ``B`` frames from their goals (:class:`AnalyticGoals`)."""
         b = pelvis_pos.shape[0]
-        # Forward kinematics down the spine, each spine joint turned by an equal share of
-        # the bend: the world rotations of the root and the spine joints ("anchors": every
-        # other joint hangs from one of them unrotated), as quaternions for the outputs and
-        # as matrices for the positions (one matrix product each; numpy's per-call overhead,
-        # not the arithmetic, is the cost of these few vectors).
-        share = quat.power(spine_bend[:, None], self.spine_shares)  # (B, S + 1, 4)
-        glob = quat.mul(pelvis_rot[:, None], share)
-        mats = quat.unit_to_matrix(glob)  # (B, S + 1, 3, 3)
+        # The world rotations and positions of the root and the spine joint ("anchors":
+        # every other joint hangs from one of them unrotated), as quaternions for the
+        # outputs and as matrices for the positions (one matrix product each; numpy's
+        # per-call overhead, not the arithmetic, is the cost of these few vectors).
+        glob = np.stack([pelvis_rot, quat.mul(pelvis_rot, spine_bend)], axis=1)  # (B, 2, 4)
+        mats = quat.unit_to_matrix(glob)  # (B, 2, 3, 3)
         root_pos = pelvis_pos - (mats[:, 0] @ self.root_to_pelvis)
-        steps = (mats[:, :-1] @ self.spine_offsets[..., None])[..., 0]  # (B, S, 3)
-        pos = root_pos[:, None] + np.concatenate([np.zeros((b, 1, 3)), steps], 1).cumsum(1)
+        pos = np.stack([root_pos, root_pos + mats[:, 0] @ self.root_to_spine], axis=1)
 
         local = np.repeat(self.template[None], b, axis=0)
         local[:, 0] = pelvis_rot
-        local[:, self.spine] = share[:, 1:2]
+        local[:, self.spine] = spine_bend
         local[:, self.head] = quat.mul(quat.conj(glob[:, self.head_anchor]), head_rot)
 
         parent = glob[:, self.upper_anchor]  # (B, 4, 4) hips' and shoulders' parents

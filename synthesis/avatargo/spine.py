@@ -5,12 +5,18 @@ from the back tracker to the headset. At run time the back bends by
 ``alpha_t = angle(w0, w_t)`` (eq. 4), about the axis ``w0 x w_t`` that turns one into the
 other, applied to the spine by forward kinematics: :func:`spine_bend`.
 
-The avatar's root also turns with the back tracker (eq. 3), and the spine hangs from it, so
-the analytic IK (:mod:`synthesis.avatargo.analytic_ik`) measures eq. 4 in the root's frame
-(:func:`spine_bend_in_root`): a turn or lean of the whole body is then the root's rotation,
-not counted a second time as a bend. With the root's rotation unchanged since the walk-in
-it is eq. 4's rotation exactly. The QP solvers use :func:`spine_bend` in the world frame on
-the rest pelvis-to-neck vector, as a soft target for the neck.
+The analytic IK (:mod:`synthesis.avatargo.analytic_ik`) reads eq. 1 as its text does,
+"the vector that joins the initial root position with the center of the head": the root
+joint to the head joint, each carried from its device by the exact offsets (eqs. 2-3),
+rather than the devices' own positions, which put the headset ~10 cm in front of the head's
+centre so that a turn of the chest reads as a sideways lean (built-in box, avatar = user:
+head error 2.3 cm with the devices' vector, 0.86 cm with the joints'). The root also turns
+with the back tracker (eq. 3) and the spine hangs from it, so eq. 4 is measured in the
+root's frame (:func:`spine_bend_in_root`): a turn or lean of the whole body is the root's
+rotation, not counted a second time as a bend. With the root's rotation unchanged since the
+walk-in it is eq. 4's rotation exactly. The QP solvers use :func:`spine_bend` on the
+devices' ``w0`` in the world frame, turning the rest pelvis-to-neck vector into a soft
+target for the neck.
 """
 
 from __future__ import annotations

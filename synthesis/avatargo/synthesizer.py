@@ -49,7 +49,7 @@ from avatar_models.body.ik import HumanoidIK, IKSettings, motion_from_qpos
 from avatar_models.rigs import identify_rig
 from render_cams import TrackingStream
 from render_cams.vr import FULL_BODY, Attachment, nominal_attachment
-from synthesis.avatargo.analytic_ik import AnalyticIK
+from synthesis.avatargo.analytic_ik import LEGS, AnalyticGoals, AnalyticIK
 from synthesis.avatargo.calibration import Roles, classes_of, identify_roles
 from synthesis.avatargo.fingers import FingerIK
 from synthesis.avatargo.hands import (
@@ -125,6 +125,9 @@ class Calibration:
         hands: wrist-in-controller offsets (left, right).
         w0: ``(3,)`` eq. 1, back tracker to headset.
         spine0: ``(3,)`` the avatar's pelvis-to-neck vector in the T-pose.
+        w0_joints: ``(3,)`` eq. 1 as its text reads it ("the initial root position" to "the
+            center of the head"): the avatar's pelvis to head joint in the T-pose, which the
+            exact offsets carry with the back tracker and the headset (eqs. 2-3).
     """
 
     roles: Roles
@@ -134,6 +137,7 @@ class Calibration:
     hands: TrackerOffsets
     w0: np.ndarray
     spine0: np.ndarray
+    w0_joints: np.ndarray
 
 
 def head_height(body: BodyDescription) -> float:
@@ -223,7 +227,7 @@ class AvatarGo(Synthesizer):
                 np.concatenate([cal.tracked.position, cal.hands.position]),
                 np.concatenate([cal.tracked.rotation, cal.hands.rotation]),
             )
-            self._w0_in_root = quat.rotate(quat.conj(cal.roles.heading), cal.w0)
+            self._w0_in_root = quat.rotate(quat.conj(cal.roles.heading), cal.w0_joints)
         else:
             self._build_qp(QP_SOLVERS[solver])
 
@@ -295,6 +299,7 @@ class AvatarGo(Synthesizer):
             hands,
             w0=p[role["hmd"]] - p[role["back_tracker"]],
             spine0=placed["neck"] - placed["pelvis"],
+            w0_joints=placed["head"] - placed["pelvis"],
         )
 
     def t_pose(self) -> np.ndarray:
@@ -371,30 +376,36 @@ class AvatarGo(Synthesizer):
             local[:, rig.joints] = self.finger_ik.local_rotations(fingers)
         return Poses(root_pos, local)
 
+    def analytic_goals(self, positions: np.ndarray, quaternions: np.ndarray) -> AnalyticGoals:
+        """The analytic solver's goals for device poses ``positions (B, 6, 3)``, unit
+        ``quaternions (B, 6, 4)`` in role order (eqs. 2-4 and the palm offsets)."""
+        devices = [FULL_BODY.index(d) for d in (*TRACKED, *HANDS)]
+        joint_pos, joint_rot = self._joint_offsets.joint_poses(
+            positions[:, devices], quaternions[:, devices]
+        )  # head, feet, root, wrists
+        w = joint_pos[:, 0] - joint_pos[:, 3]  # eq. 4's w_t: root joint to head centre
+        ends = [1, 2, 4, 5]  # ankles and wrists: the four limbs' goals (analytic_ik.LIMBS)
+        return AnalyticGoals(
+            joint_pos[:, 3],
+            joint_rot[:, 3],
+            spine_bend_in_root(self._w0_in_root, w, joint_rot[:, 3]),
+            joint_rot[:, 0],
+            joint_pos[:, ends],
+            joint_rot[:, ends],
+        )
+
     def _solve_analytic(self, pos: np.ndarray, rot: np.ndarray, seen: np.ndarray):
         """Root positions ``(B, 3)`` and local rotations ``(B, J, 4)`` by
         :class:`~synthesis.avatargo.analytic_ik.AnalyticIK` for the role-ordered device
         poses ``pos (B, 6, 3)``, ``rot (B, 6, 4)``; the walk-in T-pose where not ``seen``."""
         cal = self.calibration
         hand = [FULL_BODY.index(d) for d in HANDS]
-        devices = [FULL_BODY.index(d) for d in (*TRACKED, *HANDS)]
-        joint_pos, joint_rot = self._joint_offsets.joint_poses(pos[:, devices], rot[:, devices])
-        w = pos[:, FULL_BODY.index("hmd")] - pos[:, FULL_BODY.index("back_tracker")]
-        bend = spine_bend_in_root(self._w0_in_root, w, joint_rot[:, 3])
-        # Ankles and wrists: the goals of the four limbs (analytic_ik.LIMBS order).
-        ends = [1, 2, 4, 5]
-        solved = self.analytic.solve(
-            joint_pos[:, 3],
-            joint_rot[:, 3],
-            bend,
-            joint_rot[:, 0],
-            joint_pos[:, ends],
-            joint_rot[:, ends],
-        )
-        wrist_pos, wrist_rot = joint_pos[:, 4:], joint_rot[:, 4:]
-        wrist = solved.end_pos[:, 2:]
+        goals = self.analytic_goals(pos, rot)
+        solved = self.analytic.solve(*goals)
+        wrist_pos, wrist_rot = goals.end_pos[:, LEGS:], goals.end_rot[:, LEGS:]
+        wrist = solved.end_pos[:, LEGS:]
         palm = palm_distance(wrist, quat.unit_to_matrix(wrist_rot), pos[:, hand], self.grip)
-        reach = out_of_reach(solved.upper_pos[:, 2:], wrist_pos, self._arm_length)
+        reach = out_of_reach(solved.upper_pos[:, LEGS:], wrist_pos, self._arm_length)
         self.palm_distance.extend(palm[seen])
         self.attached.extend(reach[seen])
         if seen.all():
