@@ -6,12 +6,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from avatar_models import quat
 from avatar_models.generator import generate
 from avatar_models.generator.subject import Subject
 from synthesis.avatargo import AvatarGo
+from synthesis.avatargo.hands import REACH_SLACK_M
 from synthesis.avatargo.study import sample_user, setup_for
 from synthesis.avatargo.walk_in import walk_in
-from synthesis.base import SynthesisError, TrackingFrame
+from synthesis.base import FrameBatch, SynthesisError, TrackingFrame, on_clock
 from synthesis.methods import MethodInputs, build
 
 
@@ -55,3 +57,34 @@ def test_unknown_solver_is_refused(session):
     truth, sample, _ = session
     with pytest.raises(SynthesisError, match="solver must be one of"):
         AvatarGo(truth.skeleton, sample, solver="unity")
+
+
+def test_analytic_palm_holds_the_controller_wherever_the_arm_reaches(session):
+    """The analytic solver (the default): where the wrist's goal under the controller lies
+    within the arm's length from the shoulder (the output's own forward kinematics), the
+    palm sits on the controller; beyond it, the hand stops short by the excess and the frame
+    is reported attached once past the reach slack."""
+    truth, sample, stream = session
+    synth = AvatarGo(truth.skeleton, sample)
+    assert synth.solver == "analytic"
+    out = synth.run(stream)
+    clocked = on_clock(stream)
+    index = synth.device_index(FrameBatch.of_stream(clocked))
+    goals = synth.analytic_goals(
+        clocked.positions[:, index], quat.normalize(clocked.quaternions[:, index])
+    )
+    sk, body17 = synth.body.skeleton, synth.body.rig.body17
+    rest = sk.rest_positions()
+    palm, attached = np.array(synth.palm_distance), np.array(synth.attached)
+    reached = 0
+    for k, side in enumerate("lr"):
+        s, e, w = (sk.index(body17[f"{side}_{j}"]) for j in ("shoulder", "elbow", "wrist"))
+        arm = np.linalg.norm(rest[e] - rest[s]) + np.linalg.norm(rest[w] - rest[e])
+        beyond = np.linalg.norm(goals.end_pos[:, 2 + k] - out.global_positions()[:, s], axis=-1)
+        beyond -= arm  # (T,) how far the wrist's goal lies past the straight arm
+        inside = beyond < 0
+        reached += inside.sum()
+        np.testing.assert_allclose(palm[inside, k], 0.0, atol=1e-9)
+        np.testing.assert_allclose(palm[~inside, k], beyond[~inside], atol=1e-9)
+        np.testing.assert_array_equal(attached[:, k], beyond > REACH_SLACK_M)
+    assert reached > 0
