@@ -7,13 +7,15 @@ as the headset. :class:`AnalyticIK` is that structure on the avatar's skeleton, 
 
 1. **root**: the pelvis joint at its goal position and rotation (eqs. 2-3 of the back
    tracker); the skeleton's root carries it (the joints between them keep their rest);
-2. **spine**: eq. 4's bend (:func:`~synthesis.avatargo.spine.spine_bend_in_root`) applied
+2. **spine**: eq. 4's bend (:func:`~synthesis.avatargo.spine.spine_bend_in_root`, measured
+   from the spine joint to the head's centre, see :mod:`synthesis.avatargo.spine`) applied
    to "the spine joint" (§3.4), the first above the pelvis; the rest of the back and the
-   neck keep their rest, so the upper body turns rigidly about it and the root-to-head line
-   turns by ``alpha_t`` (spread evenly over the three spine joints of the avatar rig, the
-   head under-turned: built-in study head error 3.5 cm);
+   neck keep their rest, so the upper body turns rigidly about it (spread evenly over the
+   avatar rig's three spine joints instead, the head under-turned: 3.5 cm mean head error
+   on the built-in study);
 3. **head**: its rotation from the headset through its exact offset; its position follows
-   by forward kinematics (it is not a goal of Unity's IK either);
+   by forward kinematics (it is not a goal of Unity's IK either), on the line from the
+   spine joint to its goal;
 4. **legs and arms**: two-bone IK (:func:`synthesis.two_bone.solve`) of hip-knee-ankle onto
    the ankle's goal (eq. 2) and of shoulder-elbow-wrist onto the wrist's goal under the
    controller (:mod:`synthesis.avatargo.hands`). Bend planes (the pole of Unity's
@@ -156,6 +158,11 @@ class AnalyticIK:
         self.root_to_pelvis = rest[self.pelvis] - rest[0]
         anchors = [0, self.spine]  # the joints whose rotation the spine's bend sets
         self.root_to_spine = rest[self.spine] - rest[0]
+        self.pelvis_to_spine = rest[self.spine] - rest[self.pelvis]
+        """``(3,)`` the spine joint from the pelvis, in the pelvis's frame."""
+        self.spine_to_head = rest[head] - rest[self.spine]
+        """``(3,)`` the head from the spine joint, in the pelvis's frame at the walk-in (eq. 1's
+        ``w0`` as :mod:`synthesis.avatargo.spine` measures it)."""
         limbs = np.array([[sk.index(body17[j]) for j in limb] for limb in LIMBS])  # (4, 3)
         self.limbs = limbs
 

@@ -125,9 +125,6 @@ class Calibration:
         hands: wrist-in-controller offsets (left, right).
         w0: ``(3,)`` eq. 1, back tracker to headset.
         spine0: ``(3,)`` the avatar's pelvis-to-neck vector in the T-pose.
-        w0_joints: ``(3,)`` eq. 1 as its text reads it ("the initial root position" to "the
-            center of the head"): the avatar's pelvis to head joint in the T-pose, which the
-            exact offsets carry with the back tracker and the headset (eqs. 2-3).
     """
 
     roles: Roles
@@ -137,7 +134,6 @@ class Calibration:
     hands: TrackerOffsets
     w0: np.ndarray
     spine0: np.ndarray
-    w0_joints: np.ndarray
 
 
 def head_height(body: BodyDescription) -> float:
@@ -227,7 +223,7 @@ class AvatarGo(Synthesizer):
                 np.concatenate([cal.tracked.position, cal.hands.position]),
                 np.concatenate([cal.tracked.rotation, cal.hands.rotation]),
             )
-            self._w0_in_root = quat.rotate(quat.conj(cal.roles.heading), cal.w0_joints)
+            self._w0_in_root = self.analytic.spine_to_head  # eq. 1 in the root's frame
         else:
             self._build_qp(QP_SOLVERS[solver])
 
@@ -299,7 +295,6 @@ class AvatarGo(Synthesizer):
             hands,
             w0=p[role["hmd"]] - p[role["back_tracker"]],
             spine0=placed["neck"] - placed["pelvis"],
-            w0_joints=placed["head"] - placed["pelvis"],
         )
 
     def t_pose(self) -> np.ndarray:
@@ -383,7 +378,10 @@ class AvatarGo(Synthesizer):
         joint_pos, joint_rot = self._joint_offsets.joint_poses(
             positions[:, devices], quaternions[:, devices]
         )  # head, feet, root, wrists
-        w = joint_pos[:, 0] - joint_pos[:, 3]  # eq. 4's w_t: root joint to head centre
+        # eq. 4's w_t: from the spine joint the bend turns (on the pelvis, eqs. 2-3) to the
+        # head's centre (eqs. 2-3 of the headset); see synthesis.avatargo.spine.
+        pelvis_rot = quat.unit_to_matrix(joint_rot[:, 3])
+        w = joint_pos[:, 0] - joint_pos[:, 3] - pelvis_rot @ self.analytic.pelvis_to_spine
         ends = [1, 2, 4, 5]  # ankles and wrists: the four limbs' goals (analytic_ik.LIMBS)
         return AnalyticGoals(
             joint_pos[:, 3],
