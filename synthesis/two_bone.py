@@ -66,8 +66,14 @@ def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.stack([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx], axis=-1)
 
 
+def _norm(v: np.ndarray) -> np.ndarray:
+    """``|v|`` over the last axis, kept: np.linalg.norm's arithmetic (the same bits) without
+    its argument handling, which costs more than the sum on a step's few vectors."""
+    return np.sqrt((v * v).sum(axis=-1, keepdims=True))
+
+
 def _unit(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    norm = np.linalg.norm(v, axis=-1, keepdims=True)
+    norm = _norm(v)
     return v / np.maximum(norm, _EPS), norm[..., 0]
 
 
@@ -79,7 +85,7 @@ def shortest_arc(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     # Antiparallel directions (a bone onto its reverse, a back bent double) have no single
     # shortest arc: identity there, as for parallel ones.
     q = np.where(q[..., :1] > _EPS, q, quat.IDENTITY)
-    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+    return q / _norm(q)
 
 
 def _in_frame(q: np.ndarray, frame: np.ndarray) -> np.ndarray:
@@ -111,7 +117,7 @@ def solve(
     a, b, c = positions[..., 1, :], positions[..., 2, :], positions[..., 3, :]
     u1, l1 = _unit(b - a)
     u2, l2 = _unit(c - b)
-    d = np.clip(np.linalg.norm(target - a, axis=-1), np.abs(l1 - l2) + 1e-9, l1 + l2 - 1e-9)
+    d = np.clip(_norm(target - a)[..., 0], np.abs(l1 - l2) + 1e-9, l1 + l2 - 1e-9)
     # 1. Bend the middle joint about the normal of its current bend plane (its hinge) until
     #    root and end are ``d`` apart (law of cosines on the bend angle u1 -> u2).
     normal, bent = _unit(_cross(u1, u2))

@@ -155,6 +155,8 @@ def head_under(position: np.ndarray, rotation: np.ndarray, headset: Attachment) 
 def _first_usable(values: np.ndarray, ok: np.ndarray, last: np.ndarray) -> np.ndarray:
     """``values (B, D, n)`` with each unusable sample replaced by the device's latest usable
     one before it in the batch, or by ``last (D, n)`` (the previous batch's)."""
+    if ok.all():  # the common case: every device tracked (a per-tick fast path)
+        return values
     b = values.shape[0]
     latest = np.where(ok, np.arange(b)[:, None], -1)
     latest = np.maximum.accumulate(latest, axis=0)  # (B, D) index of the last usable sample
@@ -358,8 +360,10 @@ class AvatarGo(Synthesizer):
         pos, rot = poses[..., :3], poses[..., 3:]
         self._last_pos, self._last_rot = pos[-1], rot[-1]
         seen = np.isfinite(pos).all(-1).all(-1)  # every device tracked at least once
-        pos = np.where(seen[:, None, None], pos, 0.0)  # NaN before a device is first seen
-        rot = quat.normalize(np.where(seen[:, None, None], rot, quat.IDENTITY))
+        if not seen.all():  # NaN before a device is first seen
+            pos = np.where(seen[:, None, None], pos, 0.0)
+            rot = np.where(seen[:, None, None], rot, quat.IDENTITY)
+        rot = quat.normalize(rot)
         if self.analytic is not None:
             root_pos, local = self._solve_analytic(pos, rot, seen)
         else:
