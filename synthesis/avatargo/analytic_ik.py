@@ -18,12 +18,15 @@ as the headset. :class:`AnalyticIK` is that structure on the avatar's skeleton, 
    spine joint to its goal;
 4. **legs and arms**: two-bone IK (:func:`synthesis.two_bone.solve`) of hip-knee-ankle onto
    the ankle's goal (eq. 2) and of shoulder-elbow-wrist onto the wrist's goal under the
-   controller (:mod:`synthesis.avatargo.hands`). Bend planes (the pole of Unity's
-   TwoBoneIK): each middle joint is pre-bent from the T-pose about its hinge (the shank
-   backwards, the forearm forwards, :data:`BEND_TOWARD`), the thigh first turned about the
-   leg by the foot's twist (the knee over the toes), and the limb swung by the smallest
-   rotation onto its goal: knees point where the pelvis and feet face, elbows down and back
-   for hands held in front;
+   controller (:mod:`synthesis.avatargo.hands`): each middle joint pre-bent from the T-pose
+   about its hinge (the shank backwards, the forearm forwards, :data:`BEND_TOWARD`), the
+   law of cosines, the limb swung onto its goal; then, as the hint (pole) of Unity's
+   TwoBoneIK, the limb turned about its upper-to-end line until the knee points where the
+   foot's goal points and the elbow where it would be with the wrist straight (the hand's
+   goal rotation carrying the forearm; down and back, :data:`ELBOW_POLES`, for an arm
+   straight in it). The elbow's pole from the hand keeps the wrist within its range
+   (built-in boxing, 4 users: frames with a joint out of the humanoid's range 0.59 / 0.65 /
+   0.01 / 0.08 with no pole, 0.19 / 0.11 / 0 / 0.15 with it);
 5. **ankles and wrists**: their rotations set to their goals (eq. 3; the controller's
    rotation through the palm offset), so the palm sits on the controller wherever the
    wrist reaches its goal.
@@ -65,6 +68,13 @@ BEND_TOWARD = np.array([[-1.0, 0.0, 0.0]] * 2 + [[1.0, 0.0, 0.0]] * 2)
 """``(4, 3)`` where each middle joint's lower bone turns when it flexes, in the rest frame
 (facing +X): the shank backwards, the forearm forwards. The hinge is the lower bone crossed
 with it (:meth:`AnalyticIK.hinges`)."""
+ELBOW_POLES = np.array([[-0.3, 0.3, -1.0], [-0.3, -0.3, -1.0]])
+"""``(2, 3)`` where the elbows point (Unity's TwoBoneIK hint), left and right, in the chest's
+frame (the spine joint's; facing +X, left +Y): down, a little back and out (our choice).
+The knees point where the feet do (their goals' +X)."""
+POLE_NUDGE_M = 0.05
+"""How far the default pole pulls the middle joint's aim (our choice: a few cm, less than a
+bent limb's offset from its line, more than a straight one's)."""
 PRE_BEND_RAD = 0.2
 """The pre-bend that gives each straight rest limb its bend plane; the two-bone solve then
 sets the bend itself (any angle well away from 0 and pi gives the same result)."""
@@ -181,8 +191,7 @@ class AnalyticIK:
         self.hinges = np.cross(self.lower_bones, BEND_TOWARD)
         self.hinges /= np.linalg.norm(self.hinges, axis=-1, keepdims=True)
         self.pre_bend = quat.from_axis_angle(self.hinges, np.full(len(LIMBS), PRE_BEND_RAD))
-        self.leg_axes = (self.upper_bones + self.lower_bones)[:LEGS]
-        self.leg_axes /= np.linalg.norm(self.leg_axes, axis=-1, keepdims=True)
+        self.elbow_poles = ELBOW_POLES / np.linalg.norm(ELBOW_POLES, axis=-1, keepdims=True)
         l1 = np.linalg.norm(self.upper_bones, axis=-1)
         l2 = np.linalg.norm(self.lower_bones, axis=-1)
         knees_elbows = zip(limbs[:, 1], self.hinges, strict=True)
@@ -229,18 +238,11 @@ class AnalyticIK:
         parent = glob[:, self.upper_anchor]  # (B, 4, 4) hips' and shoulders' parents
         parent_mat = mats[:, self.upper_anchor]
         upper_pos = pos[:, self.upper_anchor] + (parent_mat @ self.upper_offsets[..., None])[..., 0]
-        # Knee over the toes: the thigh turned about the leg by the foot's twist about it.
-        foot = quat.mul(quat.conj(parent[:, :LEGS]), end_rot[:, :LEGS])  # in the hip's parent
-        along = np.sum(foot[..., 1:] * self.leg_axes, axis=-1, keepdims=True)
-        twist = np.concatenate([foot[..., :1], along * self.leg_axes], axis=-1)
-        twist /= np.linalg.norm(twist, axis=-1, keepdims=True)
-        local[:, self.limbs[:LEGS, 0]] = twist
-        upper_rot = np.concatenate([twist, np.broadcast_to(quat.IDENTITY, (b, 2, 4))], axis=1)
-        upper = quat.mul(parent, upper_rot)
-        limb_mats = quat.unit_to_matrix(np.stack([upper, quat.mul(upper, self.pre_bend)], 2))
-        middle_pos = upper_pos + (limb_mats[:, :, 0] @ self.upper_bones[..., None])[..., 0]
-        end_now = middle_pos + (limb_mats[:, :, 1] @ self.lower_bones[..., None])[..., 0]
-        globs = np.concatenate([parent_mat[:, :, None], limb_mats, limb_mats[:, :, 1:]], 2)
+        # The rest limbs, each middle joint pre-bent about its hinge (the bend plane).
+        middle_mat = quat.unit_to_matrix(quat.mul(parent, self.pre_bend))
+        middle_pos = upper_pos + (parent_mat @ self.upper_bones[..., None])[..., 0]
+        end_now = middle_pos + (middle_mat @ self.lower_bones[..., None])[..., 0]
+        globs = np.stack([parent_mat, parent_mat, middle_mat, middle_mat], 2)  # end's unused
         chain_pos = np.stack([upper_pos, upper_pos, middle_pos, end_now], axis=2)
         # Goals nearer than the flexion limit or beyond the limb's length: the reachable
         # point on the way to the goal.
@@ -249,7 +251,28 @@ class AnalyticIK:
         clipped = np.clip(dist, self.reach[:, :1], self.reach[:, 1:])
         target = upper_pos + reach * (clipped / np.maximum(dist, 1e-12))
         local = two_bone(local, globs, chain_pos, self.limbs, target)
+        # The pole (Unity's hint): each limb turned about its upper-to-end line until the
+        # knee or elbow points as near as it can to :data:`POLES`.
         limb = self.limbs
-        middle = quat.mul(quat.mul(parent, local[:, limb[:, 0]]), local[:, limb[:, 1]])
+        upper = quat.mul(parent, local[:, limb[:, 0]])
+        bent = (quat.unit_to_matrix(upper) @ self.upper_bones[..., None])[..., 0]
+        # Knees: where the feet point (their goals' +X). Elbows: where the elbow would be
+        # with the wrist straight (the hand's goal rotation carrying the forearm), nudged
+        # towards down and back for an arm straight in the hand's goal (that point then
+        # lies on the line).
+        end_mat = quat.unit_to_matrix(end_rot)  # (B, 4, 3, 3)
+        elbows = self.elbow_poles @ mats[:, 1].swapaxes(-1, -2)  # (B, 2, 3) in the world
+        straight = (end_mat[:, LEGS:] @ self.lower_bones[LEGS:, :, None])[..., 0]
+        straight = target[:, LEGS:] - straight - upper_pos[:, LEGS:]
+        pole = np.concatenate([end_mat[:, :LEGS, :, 0], straight + POLE_NUDGE_M * elbows], 1)
+        axis = target - upper_pos
+        axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
+        bent = bent - np.sum(bent * axis, -1, keepdims=True) * axis  # across the line
+        pole = pole - np.sum(pole * axis, -1, keepdims=True) * axis
+        swivel = np.arctan2(np.sum(np.cross(bent, pole) * axis, -1), np.sum(bent * pole, -1))
+        turn = quat.from_axis_angle(axis, swivel)  # (B, 4, 4); a limb along its pole: ~0
+        upper = quat.mul(turn, upper)
+        local[:, limb[:, 0]] = quat.mul(quat.conj(parent), upper)
+        middle = quat.mul(upper, local[:, limb[:, 1]])
         local[:, limb[:, 2]] = quat.mul(quat.conj(middle), end_rot)
         return AnalyticPose(root_pos, local, upper_pos, target)
