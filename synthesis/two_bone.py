@@ -58,9 +58,10 @@ def chain_fk(
     return np.stack(globs, axis=-3), np.stack(positions, axis=-2)
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``a x b`` over the last axis; np.cross's axis handling costs more than the product
-    on the few vectors of one step."""
+    on the few vectors of one step (a public helper of the limb solvers that use this
+    module)."""
     ax, ay, az = a[..., 0], a[..., 1], a[..., 2]
     bx, by, bz = b[..., 0], b[..., 1], b[..., 2]
     return np.stack([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx], axis=-1)
@@ -81,7 +82,7 @@ def shortest_arc(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``(..., 4)`` smallest rotations turning directions ``a`` onto ``b`` ``(..., 3)``."""
     a, _ = _unit(a)
     b, _ = _unit(b)
-    q = np.concatenate([1.0 + np.sum(a * b, axis=-1, keepdims=True), _cross(a, b)], axis=-1)
+    q = np.concatenate([1.0 + np.sum(a * b, axis=-1, keepdims=True), cross(a, b)], axis=-1)
     # Antiparallel directions (a bone onto its reverse, a back bent double) have no single
     # shortest arc: identity there, as for parallel ones.
     q = np.where(q[..., :1] > _EPS, q, quat.IDENTITY)
@@ -120,9 +121,9 @@ def solve(
     d = np.clip(_norm(target - a)[..., 0], np.abs(l1 - l2) + 1e-9, l1 + l2 - 1e-9)
     # 1. Bend the middle joint about the normal of its current bend plane (its hinge) until
     #    root and end are ``d`` apart (law of cosines on the bend angle u1 -> u2).
-    normal, bent = _unit(_cross(u1, u2))
+    normal, bent = _unit(cross(u1, u2))
     straight = bent < 1e-9  # a fully straight limb has no plane: bend about a horizontal axis
-    fallback, _ = _unit(_cross(u1, np.where(np.abs(u1[..., 2:]) < 0.9, _Z, _X)))
+    fallback, _ = _unit(cross(u1, np.where(np.abs(u1[..., 2:]) < 0.9, _Z, _X)))
     normal = np.where(straight[..., None], fallback, normal)
     bend_now = np.arctan2(bent, np.sum(u1 * u2, axis=-1))
     cos_bend = np.clip((d**2 - l1**2 - l2**2) / (2.0 * l1 * l2), -1.0, 1.0)
