@@ -55,3 +55,11 @@ def test_eval_avatargo_on_a_real_clip(mocap_dir: Path, source):
     assert exact < 6.0 and exact < 0.5 * fixed
     for kind in ("exact", "fixed"):
         assert set(user[kind]["physics"]) >= {"penetration_cm_p95", "skate_cm_s_median"}
+
+
+def test_eval_avatargo_refuses_an_unknown_solver(tmp_path):
+    result = runner.invoke(
+        app, ["eval", "avatargo", "--quick", "--solver", "unity", "--out", str(tmp_path)]
+    )
+    assert result.exit_code == 2
+    assert "--solver must be one of analytic, mink, least-squares" in result.output
