@@ -123,15 +123,15 @@ def solve(
     #    root and end are ``d`` apart (law of cosines on the bend angle u1 -> u2).
     normal, bent = _unit(cross(u1, u2))
     straight = bent < 1e-9  # a fully straight limb has no plane: bend about a horizontal axis
-    fallback, _ = _unit(cross(u1, np.where(np.abs(u1[..., 2:]) < 0.9, _Z, _X)))
-    normal = np.where(straight[..., None], fallback, normal)
+    if straight.any():  # (rare: skipped, it is a tenth of a step's cost)
+        fallback, _ = _unit(cross(u1, np.where(np.abs(u1[..., 2:]) < 0.9, _Z, _X)))
+        normal = np.where(straight[..., None], fallback, normal)
     bend_now = np.arctan2(bent, np.sum(u1 * u2, axis=-1))
     cos_bend = np.clip((d**2 - l1**2 - l2**2) / (2.0 * l1 * l2), -1.0, 1.0)
     turn_lower = quat.from_axis_angle(normal, np.arccos(cos_bend) - bend_now)
     new_c = b + quat.rotate(turn_lower, c - b)
     # 2. Swing the whole limb at the root, by the smallest rotation, onto the target.
     turn_upper = shortest_arc(new_c - a, target - a)
-    i, j, k = np.moveaxis(np.asarray(joints), -1, 0)
     # The end joint keeps its global rotation: undo both turns in the old middle frame.
     both = quat.mul(turn_upper, turn_lower)
     turns = np.stack(
@@ -142,7 +142,7 @@ def solve(
         ],
         axis=-2,
     )  # (B, [S,] 3, 4)
-    ijk = np.stack([i, j, k], axis=-1)
+    ijk = np.asarray(joints)
     out = rotations.copy()
     out[:, ijk] = quat.mul(turns, rotations[:, ijk])
     return out
