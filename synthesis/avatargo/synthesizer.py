@@ -27,17 +27,20 @@ Each tick (§3.4), by the per-tick IK ``solver`` (:data:`SOLVERS`):
   spine_bend_in_root`), the head turned as the headset, and closed-form two-bone limbs
   (:mod:`synthesis.two_bone`) onto the ankles' goals (eqs. 2-3) and the wrists' under the
   controllers, the ankles and wrists at their goal rotations. Vectorised over a batch's
-  frames; ~1 ms a tick on one loaded core (``avatarsim bench avatargo``), feet and root
-  on their goals (built-in study: 0.6-0.7 cm mean with realistic noise, against 1.1-1.9 cm
-  with mink).
+  frames. ``avatarsim bench avatargo`` on the shared 2-core machine (load average 3-4):
+  CPU time per tick p50 1.1 ms, p99 1.9-2.5 ms, against mink's 1.9-2.1 / 3.7-4.0 ms (the
+  1 ms p99 aim is not shown there). Feet and root on their goals: built-in study (30
+  users, realistic noise) 0.67 / 0.62 cm mean, against mink's 1.4-1.7 / 2.2 cm; the head
+  by forward kinematics 0.63 cm (mink 0.68).
 - ``"mink"`` or ``"least-squares"`` (:data:`QP_SOLVERS`): full-body IK on the avatar's
   humanoid standing in for Unity's IK (:class:`~avatar_models.body.ik.HumanoidIK`,
   warm-started, a few iterations a tick) on goals for the root (pelvis), ankles and head
   from the offsets, the spine's bend (eq. 4) as the neck's soft goal and the wrists from
   the controllers (after the first tick at the controller less the palm offset turned by
-  the wrist's solved rotation, see :data:`ORIENTATION_COST`). 4-7 ms a tick; the QP bends
-  the back and shoulders to bring a short arm's hand to its controller, where the
-  analytic limbs leave it short (and report it).
+  the wrist's solved rotation, see :data:`ORIENTATION_COST`). The QP bends the back and
+  shoulders to bring a short arm's hand to its controller (built-in study: palm 0.84 cm,
+  out of reach 3 % of frames), where the analytic limbs leave it short and report it
+  (1.15 cm, 31 %); on CMU 09_01 it drags the left shoulder 31.5 cm off to do so.
 
 Then finger IK on the controller handles (:mod:`synthesis.avatargo.fingers`) when the
 avatar has the avatar rig's finger bones. Where a controller is out of the arm's reach
