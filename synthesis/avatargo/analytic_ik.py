@@ -71,9 +71,9 @@ BEND_TOWARD = np.array([[-1.0, 0.0, 0.0]] * 2 + [[1.0, 0.0, 0.0]] * 2)
 (facing +X): the shank backwards, the forearm forwards. The hinge is the lower bone crossed
 with it (:meth:`AnalyticIK.hinges`)."""
 ELBOW_POLES = np.array([[-0.3, 0.3, -1.0], [-0.3, -0.3, -1.0]])
-"""``(2, 3)`` where the elbows point (Unity's TwoBoneIK hint), left and right, in the chest's
-frame (the spine joint's; facing +X, left +Y): down, a little back and out (our choice).
-The knees point where the feet do (their goals' +X)."""
+"""``(2, 3)`` where the elbows point (Unity's TwoBoneIK hint) for an arm straight in its hand's
+goal, left and right, in the shoulders' parents' frame (the chest's; facing +X, left +Y):
+down, a little back and out (our choice)."""
 POLE_NUDGE_M = 0.05
 """How far the default pole pulls the middle joint's aim (our choice: a few cm, less than a
 bent limb's offset from its line, more than a straight one's)."""
@@ -160,7 +160,6 @@ class AnalyticIK:
 
     def __init__(self, body: BodyDescription):
         sk, body17 = body.skeleton, body.rig.body17
-        self.n_joints = sk.n_joints
         parents = np.asarray(sk.parents)
         rest = sk.rest_positions()
         self.pelvis = sk.index(body17["pelvis"])
@@ -254,7 +253,7 @@ class AnalyticIK:
         target = upper_pos + reach * (clipped / np.maximum(dist, 1e-12))
         local = two_bone(local, globs, chain_pos, self.limbs, target)
         # The pole (Unity's hint): each limb turned about its upper-to-end line until the
-        # knee or elbow points as near as it can to :data:`POLES`.
+        # knee or elbow points as near as it can to it.
         limb = self.limbs
         upper = quat.mul(parent, local[:, limb[:, 0]])
         bent = (quat.unit_to_matrix(upper) @ self.upper_bones[..., None])[..., 0]
@@ -263,7 +262,7 @@ class AnalyticIK:
         # towards down and back for an arm straight in the hand's goal (that point then
         # lies on the line).
         end_mat = quat.unit_to_matrix(end_rot)  # (B, 4, 3, 3)
-        elbows = self.elbow_poles @ mats[:, 1].swapaxes(-1, -2)  # (B, 2, 3) in the world
+        elbows = (parent_mat[:, LEGS:] @ self.elbow_poles[..., None])[..., 0]  # (B, 2, 3)
         straight = (end_mat[:, LEGS:] @ self.lower_bones[LEGS:, :, None])[..., 0]
         straight = target[:, LEGS:] - straight - upper_pos[:, LEGS:]
         pole = np.concatenate([end_mat[:, :LEGS, :, 0], straight + POLE_NUDGE_M * elbows], 1)
