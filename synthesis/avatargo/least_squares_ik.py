@@ -24,7 +24,7 @@ Measured (``study_run``, 2 s, realistic noise, 2 iterations a tick, exact offset
 as mink on the generator's wave (head/feet/root 0.1-0.4 either way) and box (1.7-3.4
 against 0.6-3.7), worse while walking (feet 5.6/6.8, root 6.0 against 2.5/2.7, 2.2): with
 goals that conflict (fast swing feet, the fixed baseline's) it settles elsewhere than the
-QP. Hence not the default (:data:`~synthesis.avatargo.synthesizer.SOLVERS`).
+QP. Hence not mink's replacement (:data:`~synthesis.avatargo.synthesizer.QP_SOLVERS`).
 """
 
 from __future__ import annotations

@@ -445,7 +445,7 @@ class AvatarGo(Synthesizer):
                 start, steps, solve = self._q, self.iterations_per_tick, self.ik.solve_frame
                 if not self._solved:  # the first goals may be far from the walk-in T-pose
                     start, steps = self.ik.fitted_root(goal_pos[b]), FIRST_ITERATIONS
-                    solve = partial(HumanoidIK.solve_frame, self.ik)  # mink: see SOLVERS
+                    solve = partial(HumanoidIK.solve_frame, self.ik)  # mink: see QP_SOLVERS
                 else:  # the palm on the controller, whatever wrist turn the soft goal left
                     held = data.site_xmat[self._wrist_sites].reshape(2, 3, 3)
                     goal_pos[b, 5:] = pos[b, hand] - (held @ self.grip.palm[..., None])[..., 0]
