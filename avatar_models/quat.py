@@ -212,7 +212,8 @@ def from_euler(angles: np.ndarray, axes: np.ndarray) -> np.ndarray:
     """``(..., G, 3)`` intrinsic Euler angles about ``axes (G|1, 3)`` -> ``(..., G, 4)`` wxyz."""
     half = 0.5 * np.asarray(angles, float)
     cos, sin = np.cos(half), np.sin(half)
-    c0, c1, c2 = (np.stack([cos[..., n], sin[..., n]], axis=-1) for n in range(3))
+    pairs = np.stack([cos, sin], axis=-1)  # (..., G, 3, 2)
+    c0, c1, c2 = pairs[..., 0, :], pairs[..., 1, :], pairs[..., 2, :]
     products = c0[..., :, None, None] * c1[..., None, :, None] * c2[..., None, None, :]
     flat = products.reshape(*half.shape[:-1], 1, 8)
     return (flat @ _euler_products(_key(axes)))[..., 0, :]

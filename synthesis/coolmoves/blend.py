@@ -33,12 +33,12 @@ _EPS_M = 1e-9  # keeps an exact (distance 0) match finite; it then takes all the
 def inverse_distance_weights(dist: np.ndarray) -> np.ndarray:
     """``(B, k)`` weights proportional to ``1 / d`` summing to 1 (0 for missing, ``inf``)."""
     dist = np.asarray(dist, float)
-    d_min = np.min(dist, axis=-1, keepdims=True)
+    d_min = dist.min(axis=-1, keepdims=True)
     # 1/(d + eps) relative to the best match, so that an exact match cannot overflow.
     usable = np.isfinite(dist)
-    inv = np.divide(d_min + _EPS_M, dist + _EPS_M, out=np.zeros_like(dist), where=usable)
+    inv = np.divide(d_min + _EPS_M, dist + _EPS_M, out=np.zeros(dist.shape), where=usable)
     total = inv.sum(axis=-1, keepdims=True)
-    return np.divide(inv, total, out=np.zeros_like(inv), where=total > 0)
+    return np.divide(inv, total, out=np.zeros(inv.shape), where=total > 0)
 
 
 def match_likelihood(dist: np.ndarray, max_distance: float) -> np.ndarray:
@@ -49,7 +49,7 @@ def match_likelihood(dist: np.ndarray, max_distance: float) -> np.ndarray:
 
 def hand_confidence(dist: np.ndarray, weights: np.ndarray, max_distance: float) -> np.ndarray:
     """``(B,)`` weighted mean of :func:`match_likelihood` over one hand's matches."""
-    return np.sum(weights * match_likelihood(dist, max_distance), axis=-1)
+    return (weights * match_likelihood(dist, max_distance)).sum(axis=-1)
 
 
 def group_weights(
@@ -73,14 +73,17 @@ def group_weights(
     wr = inverse_distance_weights(dist_right) if weights_right is None else weights_right
     ql = hand_confidence(dist_left, wl, max_distance)
     qr = hand_confidence(dist_right, wr, max_distance)
-    zl, zr = np.zeros_like(wl), np.zeros_like(wr)
     has_l, has_r = wl.sum(-1) > 0, wr.sum(-1) > 0
     # Trunk and legs: both hands, by confidence (positive wherever a hand has a match).
     share_l = np.where(has_l & has_r, ql / np.maximum(ql + qr, 1e-300), has_l.astype(float))
-    rest = np.concatenate([share_l[:, None] * wl, (1.0 - share_l)[:, None] * wr], axis=-1)
-    weights = np.stack([np.concatenate([wl, zr], -1), np.concatenate([zl, wr], -1), rest], axis=1)
+    (b, k_left), k_right = wl.shape, wr.shape[-1]
+    weights = np.zeros((b, 3, k_left + k_right))  # filled in place: one step's few rows
+    weights[:, 0, :k_left] = wl
+    weights[:, 1, k_left:] = wr
+    weights[:, 2, :k_left] = share_l[:, None] * wl
+    weights[:, 2, k_left:] = (1.0 - share_l)[:, None] * wr
     count = has_l.astype(float) + has_r
-    rest_conf = np.divide(ql + qr, count, out=np.zeros_like(ql), where=count > 0)
+    rest_conf = np.divide(ql + qr, count, out=np.zeros(ql.shape), where=count > 0)
     return weights, np.stack([ql, qr, rest_conf], axis=1)
 
 
@@ -107,9 +110,10 @@ def blend_rotations(rotations: np.ndarray, weights: np.ndarray) -> np.ndarray:
     matches of one query are). Joints with no weight get a zero quaternion; callers keep their
     previous rotation there.
     """
-    heaviest = np.argmax(weights, axis=-1)  # (B, J)
-    ref = np.take_along_axis(rotations, heaviest[:, None, :, None], axis=1)  # (B, 1, J, 4)
-    sign = np.where(np.sum(rotations * ref, axis=-1) < 0, -1.0, 1.0)  # (B, M, J)
+    b, j = weights.shape[:2]
+    heaviest = weights.argmax(axis=-1)  # (B, J)
+    ref = rotations[np.arange(b)[:, None], heaviest, np.arange(j)]  # (B, J, 4)
+    sign = np.where((rotations * ref[:, None]).sum(axis=-1) < 0, -1.0, 1.0)  # (B, M, J)
     summed = np.einsum("bjm,bmj,bmjc->bjc", weights, sign, rotations)
-    norm = np.linalg.norm(summed, axis=-1, keepdims=True)
-    return np.divide(summed, norm, out=np.zeros_like(summed), where=norm > 1e-12)
+    norm = np.sqrt((summed * summed).sum(axis=-1, keepdims=True))  # np.linalg.norm's sum
+    return np.divide(summed, norm, out=np.zeros(summed.shape), where=norm > 1e-12)

@@ -117,10 +117,8 @@ class BothHandsKNN:
         points = np.empty((b, 2, queries.shape[-1] + 1))
         points[..., :-1] = np.where(tracked[..., None], queries, 0.0)  # NaN-free
         points[..., -1] = self._side_coord
-        dist, idx = self.tree.query(
-            points.reshape(2 * b, -1), k=list(range(1, self.k + 1)), workers=1
-        )
-        dist = np.where(tracked.reshape(2 * b, 1), dist, np.inf).reshape(b, 2, self.k)
+        dist, idx = self.tree.query(points.reshape(2 * b, -1), k=self.k, workers=1)
+        dist = np.where(tracked[..., None], dist.reshape(b, 2, self.k), np.inf)
         idx = idx.reshape(b, 2, self.k) - self._first[:, None]
         return within_threshold(dist.transpose(1, 0, 2), idx.transpose(1, 0, 2), self.max_distance)
 

@@ -72,9 +72,9 @@ class JointLimits:
             return out
         q = out[..., self.joints, :]
         angles = to_euler(q, self.axes)
-        clipped = np.clip(angles, self.lo, self.hi)
-        changed = np.any(clipped != angles, axis=-1)
-        if np.any(changed):
+        clipped = np.minimum(np.maximum(angles, self.lo), self.hi)  # np.clip's numbers
+        changed = (clipped != angles).any(axis=-1)
+        if changed.any():
             out[..., self.joints, :] = np.where(
                 changed[..., None], from_euler(clipped, self.axes), q
             )

@@ -22,9 +22,9 @@ import numpy as np
 def ewma_step(previous: np.ndarray, current: np.ndarray, weight: np.ndarray) -> np.ndarray:
     """One EWMA step on rotations ``(J, 4)`` (or ``(..., J, 4)``), weights ``(J,)`` in [0, 1]."""
     weight = np.asarray(weight, float)[..., None]
-    sign = np.where(np.sum(previous * current, axis=-1, keepdims=True) < 0, -1.0, 1.0)
+    sign = np.where((previous * current).sum(axis=-1, keepdims=True) < 0, -1.0, 1.0)
     mixed = weight * sign * current + (1.0 - weight) * previous
-    norm = np.linalg.norm(mixed, axis=-1, keepdims=True)
+    norm = np.sqrt((mixed * mixed).sum(axis=-1, keepdims=True))  # np.linalg.norm's sum
     # Antipodal halfway points (norm 0) cannot happen after the sign flip; guard anyway.
     return np.where(norm > 1e-12, mixed / np.maximum(norm, 1e-12), previous)
 

@@ -28,13 +28,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import Skeleton, quat
+from avatar_models import Skeleton
 from avatar_models.body.description import UPRIGHT_RATIO
 from avatar_models.measure import standing_height
 from avatar_models.rigs import identify_rig
 from render_cams.vr import nominal_attachment
 from synthesis.base import FrameBatch, Poses, SynthesisError, Synthesizer
-from synthesis.coolmoves.alignment import alignment_yaw
+from synthesis.coolmoves.alignment import alignment_yaw, turn_about_vertical
 from synthesis.coolmoves.blend import (
     blend_rotations,
     global_match_weight,
@@ -50,7 +50,6 @@ from synthesis.coolmoves.smoothing import ewma
 from synthesis.coolmoves.two_bone import chain_fk
 from synthesis.coolmoves.two_bone import solve as two_bone
 
-_Z = np.array([0.0, 0.0, 1.0])
 EYE_HEIGHT_FRAC = 0.936
 ANKLE_HEIGHT_FRAC = 0.039
 """Eye and ankle heights over stature (Drillis & Contini 1966, the segment-length
@@ -276,11 +275,10 @@ class CoolMoves(Synthesizer):
         )
         entries = np.concatenate([idx[0], idx[1]], axis=1)  # (B, 2k)
         safe = np.maximum(entries, 0)
-        rotations = db.poses[db.entry_pose[safe]]  # (B, 2k, J, 4)
+        rotations = db.poses[db.entry_pose[safe]]  # (B, 2k, J, 4), a copy (fancy index)
         if opts.align:
             yaw = alignment_yaw(windows, db.windows[safe], tracked, opts.align_about_centroid)
-            rotations = rotations.copy()
-            rotations[:, :, 0] = quat.mul(quat.from_axis_angle(_Z, yaw), rotations[:, :, 0])
+            rotations[:, :, 0] = turn_about_vertical(rotations[:, :, 0], yaw)
         joint_weights = weights[:, self._groups, :]  # (B, J, 2k)
         blended = blend_rotations(rotations, joint_weights)
         matched = joint_weights.sum(axis=-1) > 0

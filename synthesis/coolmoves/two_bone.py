@@ -40,19 +40,20 @@ def chain_fk(
     """
     chain = np.asarray(chain)
     mats = quat.unit_to_matrix(rotations[:, chain])  # (B, [S,] L, 3, 3)
-    pos = np.asarray(root, float)
-    if chain.ndim == 2:
-        pos = np.broadcast_to(pos[:, None], (pos.shape[0], chain.shape[0], 3))
-    scale = np.reshape(scale, (-1,) + (1,) * (pos.ndim - 1))
-    steps = offsets[chain[..., 1:]][..., None]  # (S|, L-1, 3, 1)
     glob = mats[..., 0, :, :]
-    globs, positions = [glob], [pos]
+    globs = [glob]
     for link in range(1, chain.shape[-1]):
-        pos = pos + scale * (glob @ steps[..., link - 1, :, :])[..., 0]
         glob = glob @ mats[..., link, :, :]
         globs.append(glob)
-        positions.append(pos)
-    return np.stack(globs, axis=-3), np.stack(positions, axis=-2)
+    globs = np.stack(globs, axis=-3)
+    # Each bone's offset in world axes, in one product for the whole chain; the positions
+    # are then the running sum from the root (cumsum adds in the order a loop would).
+    steps = offsets[chain[..., 1:]][..., None]  # (S|, L-1, 3, 1)
+    scale = np.reshape(scale, (-1,) + (1,) * (chain.ndim + 1))
+    bones = scale * (globs[..., :-1, :, :] @ steps)[..., 0]  # (B, [S,] L-1, 3)
+    root = np.reshape(root, (-1,) + (1,) * chain.ndim + (3,))  # (B, [1,] 1, 3)
+    root = np.broadcast_to(root, bones.shape[:-2] + (1, 3))
+    return globs, np.cumsum(np.concatenate([root, bones], axis=-2), axis=-2)
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
