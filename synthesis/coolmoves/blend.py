@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from avatar_models import quat
+
 _EPS_M = 1e-9  # keeps an exact (distance 0) match finite; it then takes all the weight
 
 
@@ -113,7 +115,7 @@ def blend_rotations(rotations: np.ndarray, weights: np.ndarray) -> np.ndarray:
     b, j = weights.shape[:2]
     heaviest = weights.argmax(axis=-1)  # (B, J)
     ref = rotations[np.arange(b)[:, None], heaviest, np.arange(j)]  # (B, J, 4)
-    sign = np.where((rotations * ref[:, None]).sum(axis=-1) < 0, -1.0, 1.0)  # (B, M, J)
+    sign = np.where(quat.dot(rotations, ref[:, None]) < 0, -1.0, 1.0)  # (B, M, J)
     summed = np.einsum("bjm,bmj,bmjc->bjc", weights, sign, rotations)
     norm = np.sqrt((summed * summed).sum(axis=-1, keepdims=True))  # np.linalg.norm's sum
     return np.divide(summed, norm, out=np.zeros(summed.shape), where=norm > 1e-12)

@@ -18,11 +18,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from avatar_models import quat
+
 
 def ewma_step(previous: np.ndarray, current: np.ndarray, weight: np.ndarray) -> np.ndarray:
     """One EWMA step on rotations ``(J, 4)`` (or ``(..., J, 4)``), weights ``(J,)`` in [0, 1]."""
     weight = np.asarray(weight, float)[..., None]
-    sign = np.where((previous * current).sum(axis=-1, keepdims=True) < 0, -1.0, 1.0)
+    sign = np.where(quat.dot(previous, current)[..., None] < 0, -1.0, 1.0)
     mixed = weight * sign * current + (1.0 - weight) * previous
     norm = np.sqrt((mixed * mixed).sum(axis=-1, keepdims=True))  # np.linalg.norm's sum
     # Antipodal halfway points (norm 0) cannot happen after the sign flip; guard anyway.

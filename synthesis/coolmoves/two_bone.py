@@ -40,20 +40,18 @@ def chain_fk(
     """
     chain = np.asarray(chain)
     mats = quat.unit_to_matrix(rotations[:, chain])  # (B, [S,] L, 3, 3)
-    glob = mats[..., 0, :, :]
-    globs = [glob]
+    globs = np.empty_like(mats)
+    globs[..., 0, :, :] = mats[..., 0, :, :]
     for link in range(1, chain.shape[-1]):
-        glob = glob @ mats[..., link, :, :]
-        globs.append(glob)
-    globs = np.stack(globs, axis=-3)
+        np.matmul(globs[..., link - 1, :, :], mats[..., link, :, :], out=globs[..., link, :, :])
     # Each bone's offset in world axes, in one product for the whole chain; the positions
     # are then the running sum from the root (cumsum adds in the order a loop would).
     steps = offsets[chain[..., 1:]][..., None]  # (S|, L-1, 3, 1)
     scale = np.reshape(scale, (-1,) + (1,) * (chain.ndim + 1))
-    bones = scale * (globs[..., :-1, :, :] @ steps)[..., 0]  # (B, [S,] L-1, 3)
-    root = np.reshape(root, (-1,) + (1,) * chain.ndim + (3,))  # (B, [1,] 1, 3)
-    root = np.broadcast_to(root, bones.shape[:-2] + (1, 3))
-    return globs, np.cumsum(np.concatenate([root, bones], axis=-2), axis=-2)
+    positions = np.empty(mats.shape[:-1])  # (B, [S,] L, 3)
+    positions[..., 0, :] = np.reshape(root, (-1,) + (1,) * (chain.ndim - 1) + (3,))
+    positions[..., 1:, :] = scale * (globs[..., :-1, :, :] @ steps)[..., 0]
+    return globs, positions.cumsum(axis=-2, out=positions)
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
