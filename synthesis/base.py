@@ -270,7 +270,9 @@ class Synthesizer(ABC):
             self._last_time = float(frame.timestamp)
         rot = poses.local_rot[0]
         # Unit length as Motion makes run's output, so that step is bit-identical to run.
-        self._last_pose = Pose(poses.root_pos[0], rot / np.linalg.norm(rot, axis=-1)[..., None])
+        # (np.linalg.norm's sum, without its Python-level wrapper.)
+        norm = np.sqrt((rot * rot).sum(axis=-1, keepdims=True))
+        self._last_pose = Pose(poses.root_pos[0], rot / norm)
         return self._last_pose
 
     def run(self, stream: TrackingStream) -> Motion:

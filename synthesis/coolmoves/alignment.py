@@ -40,7 +40,6 @@ from __future__ import annotations
 
 import numpy as np
 
-
 _SWAP_SIGNS = np.array([-1.0, -1.0, 1.0, 1.0])  # (z, y, x, w) -> (-z, -y, x, w)
 
 

@@ -94,14 +94,20 @@ def joint_groups(limb_masks: np.ndarray) -> np.ndarray:
     return np.where(limb_masks[0], 0, np.where(limb_masks[1], 1, 2))
 
 
-def global_match_weight(confidence: np.ndarray, groups: np.ndarray) -> np.ndarray:
-    """``(B,)`` mean over all joints of their group's confidence."""
+def group_shares(groups: np.ndarray) -> np.ndarray:
+    """``(3,)`` share of the joints in each group (``groups (J,)`` from :func:`joint_groups`)."""
     counts = np.bincount(groups, minlength=3).astype(float)
+    return counts / counts.sum()
+
+
+def global_match_weight(confidence: np.ndarray, shares: np.ndarray) -> np.ndarray:
+    """``(B,)`` mean over all joints of their group's confidence ``(B, 3)``, given each
+    group's share of the joints (:func:`group_shares`)."""
     # One row would take numpy's vector-dot path, whose rounding differs from the matrix-
     # vector product of a batch by an ulp (amplified to 1e-12 in the final rotations): a
     # batch of one is computed as two rows, so streaming stays bit-identical to batch.
     rows = confidence if confidence.shape[0] > 1 else np.repeat(confidence, 2, axis=0)
-    return (rows @ (counts / counts.sum()))[: confidence.shape[0]]
+    return (rows @ shares)[: confidence.shape[0]]
 
 
 def blend_rotations(rotations: np.ndarray, weights: np.ndarray) -> np.ndarray:
