@@ -54,16 +54,13 @@ def chain_fk(
     return globs, positions.cumsum(axis=-2, out=positions)
 
 
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a x b`` over the last axis; np.cross's axis handling costs more than the product
-    on the few vectors of one step."""
-    ax, ay, az = a[..., 0], a[..., 1], a[..., 2]
-    bx, by, bz = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx], axis=-1)
+def _norm(v: np.ndarray) -> np.ndarray:
+    """``|v| (..., 1)`` of ``v (..., 3)``: np.linalg.norm's sum, without its Python wrapper."""
+    return np.sqrt(np.add.reduce(v * v, axis=-1, keepdims=True))
 
 
 def _unit(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    norm = np.linalg.norm(v, axis=-1, keepdims=True)
+    norm = _norm(v)
     return v / np.maximum(norm, _EPS), norm[..., 0]
 
 
@@ -71,11 +68,10 @@ def _arc(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``(..., 4)`` smallest rotations turning directions ``a`` onto ``b`` ``(..., 3)``."""
     a, _ = _unit(a)
     b, _ = _unit(b)
-    q = np.concatenate([1.0 + np.sum(a * b, axis=-1, keepdims=True), _cross(a, b)], axis=-1)
+    cos = np.add.reduce(a * b, axis=-1, keepdims=True)
+    q = np.concatenate([1.0 + cos, quat.cross(a, b)], axis=-1)
     # Antiparallel directions never occur between a bone and its corrected self; guard anyway.
-    return np.where(q[..., :1] > _EPS, q, quat.IDENTITY) / np.maximum(
-        np.linalg.norm(q, axis=-1, keepdims=True), _EPS
-    )
+    return np.where(q[..., :1] > _EPS, q, quat.IDENTITY) / np.maximum(_norm(q), _EPS)
 
 
 def _in_frame(q: np.ndarray, frame: np.ndarray) -> np.ndarray:
@@ -107,20 +103,19 @@ def solve(
     a, b, c = positions[..., 1, :], positions[..., 2, :], positions[..., 3, :]
     u1, l1 = _unit(b - a)
     u2, l2 = _unit(c - b)
-    d = np.clip(np.linalg.norm(target - a, axis=-1), np.abs(l1 - l2) + 1e-9, l1 + l2 - 1e-9)
+    d = np.minimum(np.maximum(_norm(target - a)[..., 0], np.abs(l1 - l2) + 1e-9), l1 + l2 - 1e-9)
     # 1. Bend the middle joint about the normal of its current bend plane (its hinge) until
     #    root and end are ``d`` apart (law of cosines on the bend angle u1 -> u2).
-    normal, bent = _unit(_cross(u1, u2))
+    normal, bent = _unit(quat.cross(u1, u2))
     straight = bent < 1e-9  # a fully straight limb has no plane: bend about a horizontal axis
-    fallback, _ = _unit(_cross(u1, np.where(np.abs(u1[..., 2:]) < 0.9, _Z, _X)))
+    fallback, _ = _unit(quat.cross(u1, np.where(np.abs(u1[..., 2:]) < 0.9, _Z, _X)))
     normal = np.where(straight[..., None], fallback, normal)
-    bend_now = np.arctan2(bent, np.sum(u1 * u2, axis=-1))
-    cos_bend = np.clip((d**2 - l1**2 - l2**2) / (2.0 * l1 * l2), -1.0, 1.0)
+    bend_now = np.arctan2(bent, np.add.reduce(u1 * u2, axis=-1))
+    cos_bend = np.minimum(np.maximum((d**2 - l1**2 - l2**2) / (2.0 * l1 * l2), -1.0), 1.0)
     turn_lower = quat.from_axis_angle(normal, np.arccos(cos_bend) - bend_now)
     new_c = b + quat.rotate(turn_lower, c - b)
     # 2. Swing the whole limb at the root, by the smallest rotation, onto the target.
     turn_upper = _arc(new_c - a, target - a)
-    i, j, k = np.moveaxis(np.asarray(joints), -1, 0)
     # The end joint keeps its global rotation: undo both turns in the old middle frame.
     both = quat.mul(turn_upper, turn_lower)
     turns = np.stack(
@@ -131,7 +126,7 @@ def solve(
         ],
         axis=-2,
     )  # (B, [S,] 3, 4)
-    ijk = np.stack([i, j, k], axis=-1)
+    ijk = np.asarray(joints)
     out = rotations.copy()
     out[:, ijk] = quat.mul(turns, rotations[:, ijk])
     return out
