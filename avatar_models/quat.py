@@ -200,12 +200,18 @@ def _euler_products(axes: tuple[tuple[int, int, int], ...]) -> np.ndarray:
     return out
 
 
-def _key(axes: np.ndarray) -> tuple[tuple[int, int, int], ...]:
+def euler_key(axes: np.ndarray) -> tuple[tuple[int, int, int], ...]:
+    """``axes (G, 3)`` as a tuple of tuples: what :func:`to_euler` and :func:`from_euler`
+    look their tables up by. Callers that convert every frame may pass this instead of the
+    array, once converted (the conversion costs as much as a numpy call)."""
+    if isinstance(axes, tuple):
+        return axes
     return tuple(map(tuple, np.asarray(axes).tolist()))
 
 
-def to_euler(q: np.ndarray, axes: np.ndarray) -> np.ndarray:
-    """``(..., G, 4)`` wxyz -> ``(..., G, 3)`` intrinsic Euler angles about ``axes (G|1, 3)``.
+def to_euler(q: np.ndarray, axes: np.ndarray | tuple) -> np.ndarray:
+    """``(..., G, 4)`` wxyz -> ``(..., G, 3)`` intrinsic Euler angles about ``axes (G|1, 3)``
+    (or their :func:`euler_key`).
 
     With ``R = R_i(a) R_j(b) R_k(c)`` and ``e`` the order's parity (+1 for XYZ, YZX, ZXY):
     ``sin b = e R[i, k]``, ``a = atan2(-e R[j, k], R[k, k])``, ``c = atan2(-e R[i, j], R[i, i])``
@@ -213,7 +219,7 @@ def to_euler(q: np.ndarray, axes: np.ndarray) -> np.ndarray:
     """
     q = np.asarray(q, float)
     outer = (q[..., :, None] * q[..., None, :]).reshape(*q.shape[:-1], 1, 16)
-    entries = (outer @ _euler_forms(_key(axes)))[..., 0, :]  # (..., G, 5)
+    entries = (outer @ _euler_forms(euler_key(axes)))[..., 0, :]  # (..., G, 5)
     angles = np.empty(entries.shape[:-1] + (3,))
     np.arctan2(entries[..., 1::2], entries[..., 2::2], out=angles[..., ::2])  # a and c
     # np.clip's numbers, without its Python-level wrapper (a step calls this per sample).
@@ -221,8 +227,9 @@ def to_euler(q: np.ndarray, axes: np.ndarray) -> np.ndarray:
     return angles
 
 
-def from_euler(angles: np.ndarray, axes: np.ndarray) -> np.ndarray:
-    """``(..., G, 3)`` intrinsic Euler angles about ``axes (G|1, 3)`` -> ``(..., G, 4)`` wxyz."""
+def from_euler(angles: np.ndarray, axes: np.ndarray | tuple) -> np.ndarray:
+    """``(..., G, 3)`` intrinsic Euler angles about ``axes (G|1, 3)`` (or their
+    :func:`euler_key`) -> ``(..., G, 4)`` wxyz."""
     half = 0.5 * np.asarray(angles, float)
     pairs = np.empty(half.shape + (2,))  # (..., G, 3, cos|sin)
     np.cos(half, out=pairs[..., 0])
@@ -230,7 +237,7 @@ def from_euler(angles: np.ndarray, axes: np.ndarray) -> np.ndarray:
     c0, c1, c2 = pairs[..., 0, :], pairs[..., 1, :], pairs[..., 2, :]
     products = c0[..., :, None, None] * c1[..., None, :, None] * c2[..., None, None, :]
     flat = products.reshape(*half.shape[:-1], 1, 8)
-    return (flat @ _euler_products(_key(axes)))[..., 0, :]
+    return (flat @ _euler_products(euler_key(axes)))[..., 0, :]
 
 
 def from_axis_angle(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:

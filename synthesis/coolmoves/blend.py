@@ -35,11 +35,11 @@ _EPS_M = 1e-9  # keeps an exact (distance 0) match finite; it then takes all the
 def inverse_distance_weights(dist: np.ndarray) -> np.ndarray:
     """``(B, k)`` weights proportional to ``1 / d`` summing to 1 (0 for missing, ``inf``)."""
     dist = np.asarray(dist, float)
-    d_min = dist.min(axis=-1, keepdims=True)
+    d_min = np.minimum.reduce(dist, axis=-1, keepdims=True)
     # 1/(d + eps) relative to the best match, so that an exact match cannot overflow.
     usable = np.isfinite(dist)
     inv = np.divide(d_min + _EPS_M, dist + _EPS_M, out=np.zeros(dist.shape), where=usable)
-    total = inv.sum(axis=-1, keepdims=True)
+    total = np.add.reduce(inv, axis=-1, keepdims=True)
     return np.divide(inv, total, out=np.zeros(inv.shape), where=total > 0)
 
 
@@ -51,7 +51,7 @@ def match_likelihood(dist: np.ndarray, max_distance: float) -> np.ndarray:
 
 def hand_confidence(dist: np.ndarray, weights: np.ndarray, max_distance: float) -> np.ndarray:
     """``(B,)`` weighted mean of :func:`match_likelihood` over one hand's matches."""
-    return (weights * match_likelihood(dist, max_distance)).sum(axis=-1)
+    return np.add.reduce(weights * match_likelihood(dist, max_distance), axis=-1)
 
 
 def group_weights(
@@ -75,7 +75,7 @@ def group_weights(
     wr = inverse_distance_weights(dist_right) if weights_right is None else weights_right
     ql = hand_confidence(dist_left, wl, max_distance)
     qr = hand_confidence(dist_right, wr, max_distance)
-    has_l, has_r = wl.sum(-1) > 0, wr.sum(-1) > 0
+    has_l, has_r = np.add.reduce(wl, axis=-1) > 0, np.add.reduce(wr, axis=-1) > 0
     # Trunk and legs: both hands, by confidence (positive wherever a hand has a match).
     share_l = np.where(has_l & has_r, ql / np.maximum(ql + qr, 1e-300), has_l.astype(float))
     (b, k_left), k_right = wl.shape, wr.shape[-1]
@@ -123,5 +123,5 @@ def blend_rotations(rotations: np.ndarray, weights: np.ndarray) -> np.ndarray:
     ref = rotations[np.arange(b)[:, None], heaviest, np.arange(j)]  # (B, J, 4)
     sign = np.where(quat.dot(rotations, ref[:, None]) < 0, -1.0, 1.0)  # (B, M, J)
     summed = np.einsum("bjm,bmj,bmjc->bjc", weights, sign, rotations)
-    norm = np.sqrt((summed * summed).sum(axis=-1, keepdims=True))  # np.linalg.norm's sum
+    norm = np.sqrt(quat.dot(summed, summed))[..., None]  # np.linalg.norm's sum
     return np.divide(summed, norm, out=np.zeros(summed.shape), where=norm > 1e-12)

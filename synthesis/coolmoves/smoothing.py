@@ -26,7 +26,7 @@ def ewma_step(previous: np.ndarray, current: np.ndarray, weight: np.ndarray) -> 
     weight = np.asarray(weight, float)[..., None]
     sign = np.where(quat.dot(previous, current)[..., None] < 0, -1.0, 1.0)
     mixed = weight * sign * current + (1.0 - weight) * previous
-    norm = np.sqrt((mixed * mixed).sum(axis=-1, keepdims=True))  # np.linalg.norm's sum
+    norm = np.sqrt(quat.dot(mixed, mixed))[..., None]  # np.linalg.norm's sum
     # Antipodal halfway points (norm 0) cannot happen after the sign flip; guard anyway.
     return np.where(norm > 1e-12, mixed / np.maximum(norm, 1e-12), previous)
 

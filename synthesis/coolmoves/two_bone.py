@@ -108,8 +108,9 @@ def solve(
     #    root and end are ``d`` apart (law of cosines on the bend angle u1 -> u2).
     normal, bent = _unit(quat.cross(u1, u2))
     straight = bent < 1e-9  # a fully straight limb has no plane: bend about a horizontal axis
-    fallback, _ = _unit(quat.cross(u1, np.where(np.abs(u1[..., 2:]) < 0.9, _Z, _X)))
-    normal = np.where(straight[..., None], fallback, normal)
+    if straight.any():
+        fallback, _ = _unit(quat.cross(u1, np.where(np.abs(u1[..., 2:]) < 0.9, _Z, _X)))
+        normal = np.where(straight[..., None], fallback, normal)
     bend_now = np.arctan2(bent, np.add.reduce(u1 * u2, axis=-1))
     cos_bend = np.minimum(np.maximum((d**2 - l1**2 - l2**2) / (2.0 * l1 * l2), -1.0), 1.0)
     turn_lower = quat.from_axis_angle(normal, np.arccos(cos_bend) - bend_now)
