@@ -85,8 +85,10 @@ def group_weights(
     weights[:, 2, :k_left] = share_l[:, None] * wl
     weights[:, 2, k_left:] = (1.0 - share_l)[:, None] * wr
     count = has_l.astype(float) + has_r
-    rest_conf = np.divide(ql + qr, count, out=np.zeros(ql.shape), where=count > 0)
-    return weights, np.stack([ql, qr, rest_conf], axis=1)
+    confidence = np.zeros((b, 3))
+    confidence[:, 0], confidence[:, 1] = ql, qr
+    np.divide(ql + qr, count, out=confidence[:, 2], where=count > 0)
+    return weights, confidence
 
 
 def joint_groups(limb_masks: np.ndarray) -> np.ndarray:
@@ -106,7 +108,7 @@ def global_match_weight(confidence: np.ndarray, shares: np.ndarray) -> np.ndarra
     # One row would take numpy's vector-dot path, whose rounding differs from the matrix-
     # vector product of a batch by an ulp (amplified to 1e-12 in the final rotations): a
     # batch of one is computed as two rows, so streaming stays bit-identical to batch.
-    rows = confidence if confidence.shape[0] > 1 else np.repeat(confidence, 2, axis=0)
+    rows = confidence if confidence.shape[0] > 1 else np.concatenate([confidence, confidence])
     return (rows @ shares)[: confidence.shape[0]]
 
 

@@ -270,7 +270,7 @@ class CoolMoves(Synthesizer):
             of each joint ``(B, J)``: the global match weight where it got matches, else 0.
         """
         db, opts = self.database, self.options
-        queries = search_vectors(np.moveaxis(windows, 2, 1))  # (B, 2, F)
+        queries = search_vectors(windows.transpose(0, 2, 1, 3))  # (B, 2, F)
         dist, idx, match_weights = self._matcher.query(queries, tracked)
         weights, confidence = group_weights(
             dist[0], dist[1], opts.max_distance, match_weights[0], match_weights[1]

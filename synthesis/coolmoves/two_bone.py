@@ -39,17 +39,19 @@ def chain_fk(
         chain: ``(L,)`` or ``(S, L)`` joint indices from the root, each the parent of the next.
     """
     chain = np.asarray(chain)
-    mats = quat.unit_to_matrix(rotations[:, chain])  # (B, [S,] L, 3, 3)
-    globs = np.empty_like(mats)
-    globs[..., 0, :, :] = mats[..., 0, :, :]
+    mats = quat.unit_to_matrix(rotations[:, chain])[..., None, :, :]  # (B, [S,] L, 1, 3, 3)
+    glob = mats[..., 0, :, :, :]
+    globs = [glob]
     for link in range(1, chain.shape[-1]):
-        np.matmul(globs[..., link - 1, :, :], mats[..., link, :, :], out=globs[..., link, :, :])
+        glob = glob @ mats[..., link, :, :, :]
+        globs.append(glob)
+    globs = np.concatenate(globs, axis=-3)  # (B, [S,] L, 3, 3)
     # Each bone's offset in world axes, in one product for the whole chain; the positions
     # are then the running sum from the root (cumsum adds in the order a loop would).
     steps = offsets[chain[..., 1:]][..., None]  # (S|, L-1, 3, 1)
-    scale = np.reshape(scale, (-1,) + (1,) * (chain.ndim + 1))
-    positions = np.empty(mats.shape[:-1])  # (B, [S,] L, 3)
-    positions[..., 0, :] = np.reshape(root, (-1,) + (1,) * (chain.ndim - 1) + (3,))
+    scale = np.asarray(scale, float).reshape((-1,) + (1,) * (chain.ndim + 1))
+    positions = np.empty(globs.shape[:-1])  # (B, [S,] L, 3)
+    positions[..., 0, :] = np.asarray(root, float).reshape((-1,) + (1,) * (chain.ndim - 1) + (3,))
     positions[..., 1:, :] = scale * (globs[..., :-1, :, :] @ steps)[..., 0]
     return globs, positions.cumsum(axis=-2, out=positions)
 
@@ -119,11 +121,11 @@ def solve(
     turn_upper = _arc(new_c - a, target - a)
     # The end joint keeps its global rotation: undo both turns in the old middle frame.
     both = quat.mul(turn_upper, turn_lower)
-    turns = np.stack(
+    turns = np.concatenate(
         [
-            _in_frame(turn_upper, parent),
-            _in_frame(turn_lower, upper),
-            quat.conj(_in_frame(both, middle)),
+            _in_frame(turn_upper, parent)[..., None, :],
+            _in_frame(turn_lower, upper)[..., None, :],
+            quat.conj(_in_frame(both, middle))[..., None, :],
         ],
         axis=-2,
     )  # (B, [S,] 3, 4)
