@@ -50,45 +50,40 @@ def match_likelihood(dist: np.ndarray, max_distance: float) -> np.ndarray:
 
 
 def hand_confidence(dist: np.ndarray, weights: np.ndarray, max_distance: float) -> np.ndarray:
-    """``(B,)`` weighted mean of :func:`match_likelihood` over one hand's matches."""
+    """``(...)`` weighted mean of :func:`match_likelihood` over one hand's matches (the
+    last axis of ``dist`` and ``weights``)."""
     return np.add.reduce(weights * match_likelihood(dist, max_distance), axis=-1)
 
 
 def group_weights(
-    dist_left: np.ndarray,
-    dist_right: np.ndarray,
-    max_distance: float,
-    weights_left: np.ndarray | None = None,
-    weights_right: np.ndarray | None = None,
+    dist: np.ndarray, max_distance: float, weights: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """Match weights per joint group and each group's confidence.
 
-    Per-hand match weights default to :func:`inverse_distance_weights` of the distances (the
-    mixture variant brings its own).
-
+    Args:
+        dist: ``(2, B, k)`` distances of the left and the right hand's matches.
+        weights: ``(2, B, k)`` their match weights; by default
+            :func:`inverse_distance_weights` of the distances (the mixture variant brings
+            its own).
     Returns:
         weights ``(B, 3, M)``: rows for the left limb, the right limb and the rest; each row
         sums to 1 or is all 0 (no match for that group).
         confidence ``(B, 3)`` in [0, 1] for the same groups.
     """
-    wl = inverse_distance_weights(dist_left) if weights_left is None else weights_left
-    wr = inverse_distance_weights(dist_right) if weights_right is None else weights_right
-    ql = hand_confidence(dist_left, wl, max_distance)
-    qr = hand_confidence(dist_right, wr, max_distance)
-    has_l, has_r = np.add.reduce(wl, axis=-1) > 0, np.add.reduce(wr, axis=-1) > 0
+    w = inverse_distance_weights(dist) if weights is None else weights
+    (ql, qr), (has_l, has_r) = hand_confidence(dist, w, max_distance), np.add.reduce(w, -1) > 0
     # Trunk and legs: both hands, by confidence (positive wherever a hand has a match).
     share_l = np.where(has_l & has_r, ql / np.maximum(ql + qr, 1e-300), has_l.astype(float))
-    (b, k_left), k_right = wl.shape, wr.shape[-1]
-    weights = np.zeros((b, 3, k_left + k_right))  # filled in place: one step's few rows
-    weights[:, 0, :k_left] = wl
-    weights[:, 1, k_left:] = wr
-    weights[:, 2, :k_left] = share_l[:, None] * wl
-    weights[:, 2, k_left:] = (1.0 - share_l)[:, None] * wr
+    _, b, k = w.shape
+    out = np.zeros((b, 3, 2 * k))  # filled in place: one step's few rows
+    out[:, 0, :k], out[:, 1, k:] = w[0], w[1]
+    out[:, 2, :k] = share_l[:, None] * w[0]
+    out[:, 2, k:] = (1.0 - share_l)[:, None] * w[1]
     count = has_l.astype(float) + has_r
     confidence = np.zeros((b, 3))
     confidence[:, 0], confidence[:, 1] = ql, qr
     np.divide(ql + qr, count, out=confidence[:, 2], where=count > 0)
-    return weights, confidence
+    return out, confidence
 
 
 def joint_groups(limb_masks: np.ndarray) -> np.ndarray:
@@ -124,6 +119,8 @@ def blend_rotations(rotations: np.ndarray, weights: np.ndarray) -> np.ndarray:
     heaviest = weights.argmax(axis=-1)  # (B, J)
     ref = rotations[np.arange(b)[:, None], heaviest, np.arange(j)]  # (B, J, 4)
     sign = np.where(quat.dot(rotations, ref[:, None]) < 0, -1.0, 1.0)  # (B, M, J)
-    summed = np.einsum("bjm,bmj,bmjc->bjc", weights, sign, rotations)
+    signed = weights.transpose(0, 2, 1) * sign  # (B, M, J)
+    # The sum over matches in order (the sum einsum("bjm,bmj,bmjc->bjc") takes, cheaper).
+    summed = np.add.reduce(signed[..., None] * rotations, axis=1)
     norm = np.sqrt(quat.dot(summed, summed))[..., None]  # np.linalg.norm's sum
     return np.divide(summed, norm, out=np.zeros(summed.shape), where=norm > 1e-12)

@@ -272,9 +272,7 @@ class CoolMoves(Synthesizer):
         db, opts = self.database, self.options
         queries = search_vectors(windows.transpose(0, 2, 1, 3))  # (B, 2, F)
         dist, idx, match_weights = self._matcher.query(queries, tracked)
-        weights, confidence = group_weights(
-            dist[0], dist[1], opts.max_distance, match_weights[0], match_weights[1]
-        )
+        weights, confidence = group_weights(dist, opts.max_distance, match_weights)
         entries = np.concatenate([idx[0], idx[1]], axis=1)  # (B, 2k)
         safe = np.maximum(entries, 0)
         rotations = db.poses[db.entry_pose[safe]]  # (B, 2k, J, 4), a copy (fancy index)

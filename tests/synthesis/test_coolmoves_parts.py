@@ -202,7 +202,7 @@ def test_inverse_distance_weights_by_hand():
 def test_group_weights_route_hands_to_their_arms():
     dl = np.array([[0.1, 0.2]])
     dr = np.array([[0.3, np.inf]])
-    weights, conf = group_weights(dl, dr, max_distance=0.5)
+    weights, conf = group_weights(np.stack([dl, dr]), max_distance=0.5)
     np.testing.assert_allclose(weights[0, 0], [2 / 3, 1 / 3, 0, 0], atol=1e-8)
     np.testing.assert_allclose(weights[0, 1], [0, 0, 1, 0], atol=1e-8)
     # Each match's likelihood t / (t + d): 0.5/0.6 and 0.5/0.7 on the left, 0.5/0.8 right.
