@@ -38,15 +38,20 @@ the query cloud.
 
 from __future__ import annotations
 
+from functools import cache
+
 import numpy as np
 
 _SWAP_SIGNS = np.array([-1.0, -1.0, 1.0, 1.0])  # (z, y, x, w) -> (-z, -y, x, w)
 
 
+@cache
 def ramp_weights(n: int) -> np.ndarray:
     """``(n,)`` contributions ``c_i = i / n``, from 0 in steps of ``1 / n``, oldest sample
-    first (§3.1.4)."""
-    return np.arange(n) / n
+    first (§3.1.4); read-only (one array per ``n``, shared by every step)."""
+    ramp = np.arange(n) / n
+    ramp.flags.writeable = False
+    return ramp
 
 
 def alignment_yaw(
@@ -79,7 +84,7 @@ def alignment_yaw(
     cq = c[:, None]  # (B|1, 1, n, S)
 
     def wsum(a: np.ndarray) -> np.ndarray:
-        return (cq * a).sum(axis=(-2, -1))
+        return np.add.reduce(cq * a, axis=(-2, -1))
 
     xq_, zq_ = xq[:, None], zq[:, None]
     num = wsum(xq_ * zs - xs * zq_)

@@ -280,9 +280,9 @@ class CoolMoves(Synthesizer):
             yaw = alignment_yaw(windows, db.windows[safe], tracked, opts.align_about_centroid)
             rotations[:, :, 0] = turn_about_vertical(rotations[:, :, 0], yaw)
         blended = blend_rotations(rotations, weights[:, self._groups, :])  # (B, J, 4)
-        matched = (weights.sum(axis=-1) > 0)[:, self._groups]  # (B, J)
+        matched = (np.add.reduce(weights, axis=-1) > 0)[:, self._groups]  # (B, J)
         strength = global_match_weight(confidence, self._group_shares) if opts.smooth else 1.0
-        return blended, np.where(matched, np.reshape(strength, (-1, 1)), 0.0)
+        return blended, np.where(matched, np.asarray(strength).reshape(-1, 1), 0.0)
 
     def _place(self, rotations: np.ndarray, hmd: np.ndarray, scale: np.ndarray) -> np.ndarray:
         """Root positions ``(B, 3)`` putting each pose's headset point at ``hmd (B, 3)``.
