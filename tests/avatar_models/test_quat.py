@@ -20,6 +20,29 @@ def test_mul_rotate_conj_match_scipy():
     np.testing.assert_allclose(quat.angle(qa), a.magnitude(), atol=1e-12)
 
 
+def test_mul_dot_cross_are_the_textbook_sums_to_the_bit():
+    """The hot-path forms (permuted components, no length-4 reductions) compute the textbook
+    expressions in the textbook order: streaming CoolMoves relies on bit-identical sums."""
+    rng = np.random.default_rng(1)
+    a, b = rng.normal(size=(2, 200, 4))
+    aw, ax, ay, az = a.T
+    bw, bx, by, bz = b.T
+    textbook = np.stack(
+        [
+            aw * bw - ax * bx - ay * by - az * bz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+        ],
+        axis=-1,
+    )
+    np.testing.assert_array_equal(quat.mul(a, b), textbook)
+    np.testing.assert_array_equal(quat.mul(a[0], b), quat.mul(np.broadcast_to(a[0], b.shape), b))
+    np.testing.assert_array_equal(quat.dot(a, b), np.sum(a * b, axis=-1))
+    u, v = a[:, 1:], b[:, 1:]
+    np.testing.assert_array_equal(quat.cross(u, v), np.cross(u, v))
+
+
 def test_power_is_scipy_slerp_step():
     rng = np.random.default_rng(4)
     a, b = Rotation.random(40, random_state=rng), Rotation.random(40, random_state=rng)
