@@ -118,8 +118,9 @@ def blend_rotations(rotations: np.ndarray, weights: np.ndarray) -> np.ndarray:
     b, j = weights.shape[:2]
     heaviest = weights.argmax(axis=-1)  # (B, J)
     ref = rotations[np.arange(b)[:, None], heaviest, np.arange(j)]  # (B, J, 4)
-    sign = np.where(quat.dot(rotations, ref[:, None]) < 0, -1.0, 1.0)  # (B, M, J)
-    signed = weights.transpose(0, 2, 1) * sign  # (B, M, J)
+    weights = weights.transpose(0, 2, 1)  # (B, M, J)
+    # Each weight signed by its match's hemisphere (negating is exact: w * -1 is -w).
+    signed = np.where(quat.dot(rotations, ref[:, None]) < 0, -weights, weights)
     # The sum over matches in order (the sum einsum("bjm,bmj,bmjc->bjc") takes, cheaper).
     summed = np.add.reduce(signed[..., None] * rotations, axis=1)
     norm = np.sqrt(quat.dot(summed, summed))[..., None]  # np.linalg.norm's sum
