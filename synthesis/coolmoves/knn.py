@@ -86,6 +86,15 @@ class BothHandsKNN:
     k nearest on its own side, at the distances of the side's own tree (the extra term is
     exactly 0).
 
+    Measured on the ``avatarsim bench coolmoves`` database (11 609 windows a side, per-frame
+    best of 5, thread CPU time, a loaded 2-core machine): this query takes 78 us at the
+    median, 150 us at p99, of which about 37 us is ``cKDTree.query``'s fixed cost per call
+    (a 50-point tree costs as much). Two per-side trees took 103 / 179 us; leaf sizes 24 to
+    96 gained nothing reliable and reorder equidistant matches; a brute-force product with
+    ``argpartition`` took 440 us; the previous step's k-th distance as
+    ``distance_upper_bound`` gained nothing (a window's neighbours are found fast, proving
+    them is the cost).
+
     Args:
         vectors: per side (left, right) ``(N_s, F)`` search vectors of the database windows.
     """
