@@ -77,10 +77,16 @@ def _arc(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def _in_frame(q: np.ndarray, frame: np.ndarray) -> np.ndarray:
-    """World rotation ``q (..., 4)`` expressed in the local axes ``frame (..., 3, 3)``:
+    """World rotations ``q (..., 4)`` expressed in the local axes ``frame (..., 3, 3)``:
     ``frame^T R frame`` is the same angle about the axis ``frame^T n``."""
-    vec = (q[..., None, 1:] @ frame)[..., 0, :]
-    return np.concatenate([q[..., :1], vec], axis=-1)
+    out = np.empty(q.shape)
+    out[..., :1] = q[..., :1]
+    out[..., 1:] = (q[..., None, 1:] @ frame)[..., 0, :]
+    return out
+
+
+_UNDO_LAST = np.array([[1.0, 1, 1, 1], [1, 1, 1, 1], [1, -1, -1, -1]])
+"""Conjugates the third of three stacked quaternions (quat.conj's sign pattern)."""
 
 
 def solve(
@@ -101,7 +107,6 @@ def solve(
         joints: indices ``(3,)`` or ``(S, 3)`` of the upper, middle and end joints.
         target: ``(B, [S,] 3)`` where the end joint should go.
     """
-    parent, upper, middle = globs[..., 0, :, :], globs[..., 1, :, :], globs[..., 2, :, :]
     a, b, c = positions[..., 1, :], positions[..., 2, :], positions[..., 3, :]
     u1, l1 = _unit(b - a)
     u2, l2 = _unit(c - b)
@@ -121,14 +126,12 @@ def solve(
     turn_upper = _arc(new_c - a, target - a)
     # The end joint keeps its global rotation: undo both turns in the old middle frame.
     both = quat.mul(turn_upper, turn_lower)
+    # The three turns in the frames of the parent, upper and middle joints (the first three
+    # of ``globs``) in one product; the middle joint's is undone (conjugated).
     turns = np.concatenate(
-        [
-            _in_frame(turn_upper, parent)[..., None, :],
-            _in_frame(turn_lower, upper)[..., None, :],
-            quat.conj(_in_frame(both, middle))[..., None, :],
-        ],
-        axis=-2,
-    )  # (B, [S,] 3, 4)
+        [turn_upper[..., None, :], turn_lower[..., None, :], both[..., None, :]], axis=-2
+    )
+    turns = _in_frame(turns, globs[..., :3, :, :]) * _UNDO_LAST  # (B, [S,] 3, 4)
     ijk = np.asarray(joints)
     out = rotations.copy()
     out[:, ijk] = quat.mul(turns, rotations[:, ijk])
