@@ -15,12 +15,14 @@ real mocap is present, a Bandai dataset-2 walk driving a database of three other
 The script uses only the registry and the synthesiser contract, so it runs on another
 checkout too: ``PYTHONPATH=/path/to/main python <this file> outputs main.npz``.
 
-Measured on 2026-12-02 on a shared 2-core machine (load 2.8-3.5), ``timing 7``, main at
-41759a9 against branch ``cmfast``; outputs of every array equal to the bit:
+Measured on 2026-12-02 on a shared 2-core machine (load 3.1-3.4), ``timing 7`` twice on
+each checkout, back to back, main at 41759a9 against branch ``cmfast`` (ms of CPU per step;
+``outputs`` + ``compare``: every array equal to the bit, step equal to run on both inputs):
 
-    method             main best-of-7 p50 / p99   branch best-of-7 p50 / p99   (ms CPU)
-    coolmoves               0.97-1.01 / 1.11-1.18        0.62 / 0.75-0.76
-    coolmoves+arm-ik        1.69-1.74 / 1.86-1.98        1.03-1.04 / 1.22
+                      main                          branch
+                      best of 7 p50/p99   every p99  best of 7 p50/p99   every p99
+    coolmoves         1.01-1.02/1.20-1.26 1.98-2.08  0.59-0.60/0.69      0.77-0.95
+    coolmoves+arm-ik  1.70-1.73/1.88-1.95 3.62-3.69  0.97-0.98/1.05-1.08 1.12-1.20
 """
 
 from __future__ import annotations
