@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import AvatarsimError, Motion, Skeleton
+from avatar_models import AvatarsimError, Motion, Skeleton, quat
 from render_cams import TrackingStream
 
 DEFAULT_RATE_HZ = 90.0
@@ -270,7 +270,8 @@ class Synthesizer(ABC):
             self._last_time = float(frame.timestamp)
         rot = poses.local_rot[0]
         # Unit length as Motion makes run's output, so that step is bit-identical to run.
-        self._last_pose = Pose(poses.root_pos[0], rot / np.linalg.norm(rot, axis=-1)[..., None])
+        # (np.linalg.norm's sum, without its Python wrapper and its length-4 reduction.)
+        self._last_pose = Pose(poses.root_pos[0], rot / np.sqrt(quat.dot(rot, rot))[..., None])
         return self._last_pose
 
     def run(self, stream: TrackingStream) -> Motion:

@@ -42,35 +42,26 @@ def chain_fk(
         chain: ``(L,)`` or ``(S, L)`` joint indices from the root, each the parent of the next.
     """
     chain = np.asarray(chain)
-    mats = quat.unit_to_matrix(rotations[:, chain])  # (B, [S,] L, 3, 3)
-    pos = np.asarray(root, float)
-    if chain.ndim == 2:
-        pos = np.broadcast_to(pos[:, None], (pos.shape[0], chain.shape[0], 3))
-    scale = np.reshape(scale, (-1,) + (1,) * (pos.ndim - 1))
-    steps = offsets[chain[..., 1:]][..., None]  # (S|, L-1, 3, 1)
-    glob = mats[..., 0, :, :]
-    globs, positions = [glob], [pos]
+    mats = quat.unit_to_matrix(rotations[:, chain])[..., None, :, :]  # (B, [S,] L, 1, 3, 3)
+    glob = mats[..., 0, :, :, :]
+    globs = [glob]
     for link in range(1, chain.shape[-1]):
-        pos = pos + scale * (glob @ steps[..., link - 1, :, :])[..., 0]
-        glob = glob @ mats[..., link, :, :]
+        glob = glob @ mats[..., link, :, :, :]
         globs.append(glob)
-        positions.append(pos)
-    return np.stack(globs, axis=-3), np.stack(positions, axis=-2)
-
-
-def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a x b`` over the last axis; np.cross's axis handling costs more than the product
-    on the few vectors of one step (a public helper of the limb solvers that use this
-    module)."""
-    ax, ay, az = a[..., 0], a[..., 1], a[..., 2]
-    bx, by, bz = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx], axis=-1)
+    globs = np.concatenate(globs, axis=-3)  # (B, [S,] L, 3, 3)
+    # Each bone's offset in world axes, in one product for the whole chain; the positions
+    # are then the running sum from the root (cumsum adds in the order a loop would).
+    steps = offsets[chain[..., 1:]][..., None]  # (S|, L-1, 3, 1)
+    scale = np.asarray(scale, float).reshape((-1,) + (1,) * (chain.ndim + 1))
+    positions = np.empty(globs.shape[:-1])  # (B, [S,] L, 3)
+    positions[..., 0, :] = np.asarray(root, float).reshape((-1,) + (1,) * (chain.ndim - 1) + (3,))
+    positions[..., 1:, :] = scale * (globs[..., :-1, :, :] @ steps)[..., 0]
+    return globs, positions.cumsum(axis=-2, out=positions)
 
 
 def _norm(v: np.ndarray) -> np.ndarray:
-    """``|v|`` over the last axis, kept: np.linalg.norm's arithmetic (the same bits) without
-    its argument handling, which costs more than the sum on a step's few vectors."""
-    return np.sqrt((v * v).sum(axis=-1, keepdims=True))
+    """``|v| (..., 1)`` of ``v (..., 3)``: np.linalg.norm's sum, without its Python wrapper."""
+    return np.sqrt(np.add.reduce(v * v, axis=-1, keepdims=True))
 
 
 def _unit(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -82,18 +73,24 @@ def shortest_arc(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``(..., 4)`` smallest rotations turning directions ``a`` onto ``b`` ``(..., 3)``."""
     a, _ = _unit(a)
     b, _ = _unit(b)
-    q = np.concatenate([1.0 + np.sum(a * b, axis=-1, keepdims=True), cross(a, b)], axis=-1)
+    cos = np.add.reduce(a * b, axis=-1, keepdims=True)
+    q = np.concatenate([1.0 + cos, quat.cross(a, b)], axis=-1)
     # Antiparallel directions (a bone onto its reverse, a back bent double) have no single
     # shortest arc: identity there, as for parallel ones.
-    q = np.where(q[..., :1] > _EPS, q, quat.IDENTITY)
-    return q / _norm(q)
+    return np.where(q[..., :1] > _EPS, q, quat.IDENTITY) / np.maximum(_norm(q), _EPS)
 
 
 def _in_frame(q: np.ndarray, frame: np.ndarray) -> np.ndarray:
-    """World rotation ``q (..., 4)`` expressed in the local axes ``frame (..., 3, 3)``:
+    """World rotations ``q (..., 4)`` expressed in the local axes ``frame (..., 3, 3)``:
     ``frame^T R frame`` is the same angle about the axis ``frame^T n``."""
-    vec = (q[..., None, 1:] @ frame)[..., 0, :]
-    return np.concatenate([q[..., :1], vec], axis=-1)
+    out = np.empty(q.shape)
+    out[..., :1] = q[..., :1]
+    out[..., 1:] = (q[..., None, 1:] @ frame)[..., 0, :]
+    return out
+
+
+_UNDO_LAST = np.array([[1.0, 1, 1, 1], [1, 1, 1, 1], [1, -1, -1, -1]])
+"""Conjugates the third of three stacked quaternions (quat.conj's sign pattern)."""
 
 
 def solve(
@@ -114,34 +111,31 @@ def solve(
         joints: indices ``(3,)`` or ``(S, 3)`` of the upper, middle and end joints.
         target: ``(B, [S,] 3)`` where the end joint should go.
     """
-    parent, upper, middle = globs[..., 0, :, :], globs[..., 1, :, :], globs[..., 2, :, :]
     a, b, c = positions[..., 1, :], positions[..., 2, :], positions[..., 3, :]
     u1, l1 = _unit(b - a)
     u2, l2 = _unit(c - b)
-    d = np.clip(_norm(target - a)[..., 0], np.abs(l1 - l2) + 1e-9, l1 + l2 - 1e-9)
+    d = np.minimum(np.maximum(_norm(target - a)[..., 0], np.abs(l1 - l2) + 1e-9), l1 + l2 - 1e-9)
     # 1. Bend the middle joint about the normal of its current bend plane (its hinge) until
     #    root and end are ``d`` apart (law of cosines on the bend angle u1 -> u2).
-    normal, bent = _unit(cross(u1, u2))
+    normal, bent = _unit(quat.cross(u1, u2))
     straight = bent < 1e-9  # a fully straight limb has no plane: bend about a horizontal axis
-    if straight.any():  # (rare: skipped, it is a tenth of a step's cost)
-        fallback, _ = _unit(cross(u1, np.where(np.abs(u1[..., 2:]) < 0.9, _Z, _X)))
+    if straight.any():
+        fallback, _ = _unit(quat.cross(u1, np.where(np.abs(u1[..., 2:]) < 0.9, _Z, _X)))
         normal = np.where(straight[..., None], fallback, normal)
-    bend_now = np.arctan2(bent, np.sum(u1 * u2, axis=-1))
-    cos_bend = np.clip((d**2 - l1**2 - l2**2) / (2.0 * l1 * l2), -1.0, 1.0)
+    bend_now = np.arctan2(bent, np.add.reduce(u1 * u2, axis=-1))
+    cos_bend = np.minimum(np.maximum((d**2 - l1**2 - l2**2) / (2.0 * l1 * l2), -1.0), 1.0)
     turn_lower = quat.from_axis_angle(normal, np.arccos(cos_bend) - bend_now)
     new_c = b + quat.rotate(turn_lower, c - b)
     # 2. Swing the whole limb at the root, by the smallest rotation, onto the target.
     turn_upper = shortest_arc(new_c - a, target - a)
     # The end joint keeps its global rotation: undo both turns in the old middle frame.
     both = quat.mul(turn_upper, turn_lower)
-    turns = np.stack(
-        [
-            _in_frame(turn_upper, parent),
-            _in_frame(turn_lower, upper),
-            quat.conj(_in_frame(both, middle)),
-        ],
-        axis=-2,
-    )  # (B, [S,] 3, 4)
+    # The three turns in the frames of the parent, upper and middle joints (the first three
+    # of ``globs``) in one product; the middle joint's is undone (conjugated).
+    turns = np.concatenate(
+        [turn_upper[..., None, :], turn_lower[..., None, :], both[..., None, :]], axis=-2
+    )
+    turns = _in_frame(turns, globs[..., :3, :, :]) * _UNDO_LAST  # (B, [S,] 3, 4)
     ijk = np.asarray(joints)
     out = rotations.copy()
     out[:, ijk] = quat.mul(turns, rotations[:, ijk])

@@ -55,7 +55,6 @@ import numpy as np
 
 from avatar_models import quat
 from avatar_models.body import BodyDescription
-from synthesis.two_bone import cross
 from synthesis.two_bone import solve as two_bone
 
 LIMBS = (
@@ -189,7 +188,7 @@ class AnalyticIK:
         self.upper_offsets = rest[limbs[:, 0]] - rest[np.array(anchors)[self.upper_anchor]]
         self.upper_bones = rest[limbs[:, 1]] - rest[limbs[:, 0]]  # (4, 3)
         self.lower_bones = rest[limbs[:, 2]] - rest[limbs[:, 1]]
-        self.hinges = cross(self.lower_bones, BEND_TOWARD)
+        self.hinges = quat.cross(self.lower_bones, BEND_TOWARD)
         self.hinges /= np.linalg.norm(self.hinges, axis=-1, keepdims=True)
         self.pre_bend = quat.from_axis_angle(self.hinges, np.full(len(LIMBS), PRE_BEND_RAD))
         self.elbow_poles = ELBOW_POLES / np.linalg.norm(ELBOW_POLES, axis=-1, keepdims=True)
@@ -270,7 +269,7 @@ class AnalyticIK:
         axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
         bent = bent - np.sum(bent * axis, -1, keepdims=True) * axis  # across the line
         pole = pole - np.sum(pole * axis, -1, keepdims=True) * axis
-        swivel = np.arctan2(np.sum(cross(bent, pole) * axis, -1), np.sum(bent * pole, -1))
+        swivel = np.arctan2(np.sum(quat.cross(bent, pole) * axis, -1), np.sum(bent * pole, -1))
         turn = quat.from_axis_angle(axis, swivel)  # (B, 4, 4); a limb along its pole: ~0
         upper = quat.mul(turn, upper)
         local[:, limb[:, 0]] = quat.mul(quat.conj(parent), upper)

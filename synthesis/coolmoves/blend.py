@@ -27,18 +27,20 @@ from __future__ import annotations
 
 import numpy as np
 
+from avatar_models import quat
+
 _EPS_M = 1e-9  # keeps an exact (distance 0) match finite; it then takes all the weight
 
 
 def inverse_distance_weights(dist: np.ndarray) -> np.ndarray:
     """``(B, k)`` weights proportional to ``1 / d`` summing to 1 (0 for missing, ``inf``)."""
     dist = np.asarray(dist, float)
-    d_min = np.min(dist, axis=-1, keepdims=True)
+    d_min = np.minimum.reduce(dist, axis=-1, keepdims=True)
     # 1/(d + eps) relative to the best match, so that an exact match cannot overflow.
     usable = np.isfinite(dist)
-    inv = np.divide(d_min + _EPS_M, dist + _EPS_M, out=np.zeros_like(dist), where=usable)
-    total = inv.sum(axis=-1, keepdims=True)
-    return np.divide(inv, total, out=np.zeros_like(inv), where=total > 0)
+    inv = np.divide(d_min + _EPS_M, dist + _EPS_M, out=np.zeros(dist.shape), where=usable)
+    total = np.add.reduce(inv, axis=-1, keepdims=True)
+    return np.divide(inv, total, out=np.zeros(inv.shape), where=total > 0)
 
 
 def match_likelihood(dist: np.ndarray, max_distance: float) -> np.ndarray:
@@ -48,40 +50,40 @@ def match_likelihood(dist: np.ndarray, max_distance: float) -> np.ndarray:
 
 
 def hand_confidence(dist: np.ndarray, weights: np.ndarray, max_distance: float) -> np.ndarray:
-    """``(B,)`` weighted mean of :func:`match_likelihood` over one hand's matches."""
-    return np.sum(weights * match_likelihood(dist, max_distance), axis=-1)
+    """``(...)`` weighted mean of :func:`match_likelihood` over one hand's matches (the
+    last axis of ``dist`` and ``weights``)."""
+    return np.add.reduce(weights * match_likelihood(dist, max_distance), axis=-1)
 
 
 def group_weights(
-    dist_left: np.ndarray,
-    dist_right: np.ndarray,
-    max_distance: float,
-    weights_left: np.ndarray | None = None,
-    weights_right: np.ndarray | None = None,
+    dist: np.ndarray, max_distance: float, weights: np.ndarray | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """Match weights per joint group and each group's confidence.
 
-    Per-hand match weights default to :func:`inverse_distance_weights` of the distances (the
-    mixture variant brings its own).
-
+    Args:
+        dist: ``(2, B, k)`` distances of the left and the right hand's matches.
+        weights: ``(2, B, k)`` their match weights; by default
+            :func:`inverse_distance_weights` of the distances (the mixture variant brings
+            its own).
     Returns:
         weights ``(B, 3, M)``: rows for the left limb, the right limb and the rest; each row
         sums to 1 or is all 0 (no match for that group).
         confidence ``(B, 3)`` in [0, 1] for the same groups.
     """
-    wl = inverse_distance_weights(dist_left) if weights_left is None else weights_left
-    wr = inverse_distance_weights(dist_right) if weights_right is None else weights_right
-    ql = hand_confidence(dist_left, wl, max_distance)
-    qr = hand_confidence(dist_right, wr, max_distance)
-    zl, zr = np.zeros_like(wl), np.zeros_like(wr)
-    has_l, has_r = wl.sum(-1) > 0, wr.sum(-1) > 0
+    w = inverse_distance_weights(dist) if weights is None else weights
+    (ql, qr), (has_l, has_r) = hand_confidence(dist, w, max_distance), np.add.reduce(w, -1) > 0
     # Trunk and legs: both hands, by confidence (positive wherever a hand has a match).
     share_l = np.where(has_l & has_r, ql / np.maximum(ql + qr, 1e-300), has_l.astype(float))
-    rest = np.concatenate([share_l[:, None] * wl, (1.0 - share_l)[:, None] * wr], axis=-1)
-    weights = np.stack([np.concatenate([wl, zr], -1), np.concatenate([zl, wr], -1), rest], axis=1)
+    _, b, k = w.shape
+    out = np.zeros((b, 3, 2 * k))  # filled in place: one step's few rows
+    out[:, 0, :k], out[:, 1, k:] = w[0], w[1]
+    out[:, 2, :k] = share_l[:, None] * w[0]
+    out[:, 2, k:] = (1.0 - share_l)[:, None] * w[1]
     count = has_l.astype(float) + has_r
-    rest_conf = np.divide(ql + qr, count, out=np.zeros_like(ql), where=count > 0)
-    return weights, np.stack([ql, qr, rest_conf], axis=1)
+    confidence = np.zeros((b, 3))
+    confidence[:, 0], confidence[:, 1] = ql, qr
+    np.divide(ql + qr, count, out=confidence[:, 2], where=count > 0)
+    return out, confidence
 
 
 def joint_groups(limb_masks: np.ndarray) -> np.ndarray:
@@ -89,14 +91,20 @@ def joint_groups(limb_masks: np.ndarray) -> np.ndarray:
     return np.where(limb_masks[0], 0, np.where(limb_masks[1], 1, 2))
 
 
-def global_match_weight(confidence: np.ndarray, groups: np.ndarray) -> np.ndarray:
-    """``(B,)`` mean over all joints of their group's confidence."""
+def group_shares(groups: np.ndarray) -> np.ndarray:
+    """``(3,)`` share of the joints in each group (``groups (J,)`` from :func:`joint_groups`)."""
     counts = np.bincount(groups, minlength=3).astype(float)
+    return counts / counts.sum()
+
+
+def global_match_weight(confidence: np.ndarray, shares: np.ndarray) -> np.ndarray:
+    """``(B,)`` mean over all joints of their group's confidence ``(B, 3)``, given each
+    group's share of the joints (:func:`group_shares`)."""
     # One row would take numpy's vector-dot path, whose rounding differs from the matrix-
     # vector product of a batch by an ulp (amplified to 1e-12 in the final rotations): a
     # batch of one is computed as two rows, so streaming stays bit-identical to batch.
-    rows = confidence if confidence.shape[0] > 1 else np.repeat(confidence, 2, axis=0)
-    return (rows @ (counts / counts.sum()))[: confidence.shape[0]]
+    rows = confidence if confidence.shape[0] > 1 else np.concatenate([confidence, confidence])
+    return (rows @ shares)[: confidence.shape[0]]
 
 
 def blend_rotations(rotations: np.ndarray, weights: np.ndarray) -> np.ndarray:
@@ -107,9 +115,13 @@ def blend_rotations(rotations: np.ndarray, weights: np.ndarray) -> np.ndarray:
     matches of one query are). Joints with no weight get a zero quaternion; callers keep their
     previous rotation there.
     """
-    heaviest = np.argmax(weights, axis=-1)  # (B, J)
-    ref = np.take_along_axis(rotations, heaviest[:, None, :, None], axis=1)  # (B, 1, J, 4)
-    sign = np.where(np.sum(rotations * ref, axis=-1) < 0, -1.0, 1.0)  # (B, M, J)
-    summed = np.einsum("bjm,bmj,bmjc->bjc", weights, sign, rotations)
-    norm = np.linalg.norm(summed, axis=-1, keepdims=True)
-    return np.divide(summed, norm, out=np.zeros_like(summed), where=norm > 1e-12)
+    b, j = weights.shape[:2]
+    heaviest = weights.argmax(axis=-1)  # (B, J)
+    ref = rotations[np.arange(b)[:, None], heaviest, np.arange(j)]  # (B, J, 4)
+    weights = weights.transpose(0, 2, 1)  # (B, M, J)
+    # Each weight signed by its match's hemisphere (negating is exact: w * -1 is -w).
+    signed = np.where(quat.dot(rotations, ref[:, None]) < 0, -weights, weights)
+    # The sum over matches in order (the sum einsum("bjm,bmj,bmjc->bjc") takes, cheaper).
+    summed = np.add.reduce(signed[..., None] * rotations, axis=1)
+    norm = np.sqrt(quat.dot(summed, summed))[..., None]  # np.linalg.norm's sum
+    return np.divide(summed, norm, out=np.zeros(summed.shape), where=norm > 1e-12)

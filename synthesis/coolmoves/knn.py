@@ -86,6 +86,15 @@ class BothHandsKNN:
     k nearest on its own side, at the distances of the side's own tree (the extra term is
     exactly 0).
 
+    Measured on the ``avatarsim bench coolmoves`` database (11 609 windows a side, per-frame
+    best of 5, thread CPU time, a loaded 2-core machine): this query takes 78 us at the
+    median, 150 us at p99, of which about 37 us is ``cKDTree.query``'s fixed cost per call
+    (a 50-point tree costs as much). Two per-side trees took 103 / 179 us; leaf sizes 24 to
+    96 gained nothing reliable and reorder equidistant matches; a brute-force product with
+    ``argpartition`` took 440 us; the previous step's k-th distance as
+    ``distance_upper_bound`` gained nothing (a window's neighbours are found fast, proving
+    them is the cost).
+
     Args:
         vectors: per side (left, right) ``(N_s, F)`` search vectors of the database windows.
     """
@@ -117,10 +126,8 @@ class BothHandsKNN:
         points = np.empty((b, 2, queries.shape[-1] + 1))
         points[..., :-1] = np.where(tracked[..., None], queries, 0.0)  # NaN-free
         points[..., -1] = self._side_coord
-        dist, idx = self.tree.query(
-            points.reshape(2 * b, -1), k=list(range(1, self.k + 1)), workers=1
-        )
-        dist = np.where(tracked.reshape(2 * b, 1), dist, np.inf).reshape(b, 2, self.k)
+        dist, idx = self.tree.query(points.reshape(2 * b, -1), k=self.k, workers=1)
+        dist = np.where(tracked[..., None], dist.reshape(b, 2, self.k), np.inf)
         idx = idx.reshape(b, 2, self.k) - self._first[:, None]
         return within_threshold(dist.transpose(1, 0, 2), idx.transpose(1, 0, 2), self.max_distance)
 

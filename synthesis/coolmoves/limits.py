@@ -22,7 +22,7 @@ import numpy as np
 from avatar_models import Skeleton
 from avatar_models.body.anatomy import classify
 from avatar_models.body.joint_ranges import euler_order
-from avatar_models.quat import euler_axes, from_euler, to_euler
+from avatar_models.quat import euler_axes, euler_key, from_euler, to_euler
 from avatar_models.rigs import RigError, identify_rig
 
 _DEFAULT_ORDER = "XYZ"
@@ -60,6 +60,7 @@ class JointLimits:
             [[r.get(f"r{a.lower()}", (-np.pi, np.pi)) for a in order] for r, order in pairs]
         ).reshape(len(joints), 3, 2)  # (G, 3 axes, lo/hi)
         self.lo, self.hi = bounds[..., 0], bounds[..., 1]
+        self._orders = euler_key(self.axes)  # converted once, not on every clamp
         if widen_to is not None and len(widen_to) and joints:
             angles = to_euler(np.asarray(widen_to)[:, self.joints], self.axes)  # (P, G, 3)
             self.lo = np.minimum(self.lo, angles.min(axis=0))
@@ -71,11 +72,11 @@ class JointLimits:
         if not self.joints.size:
             return out
         q = out[..., self.joints, :]
-        angles = to_euler(q, self.axes)
-        clipped = np.clip(angles, self.lo, self.hi)
-        changed = np.any(clipped != angles, axis=-1)
-        if np.any(changed):
+        angles = to_euler(q, self._orders)
+        clipped = np.minimum(np.maximum(angles, self.lo), self.hi)  # np.clip's numbers
+        changed = np.logical_or.reduce(clipped != angles, axis=-1)
+        if changed.any():
             out[..., self.joints, :] = np.where(
-                changed[..., None], from_euler(clipped, self.axes), q
+                changed[..., None], from_euler(clipped, self._orders), q
             )
         return out

@@ -18,13 +18,16 @@ from __future__ import annotations
 
 import numpy as np
 
+from avatar_models import quat
+
 
 def ewma_step(previous: np.ndarray, current: np.ndarray, weight: np.ndarray) -> np.ndarray:
     """One EWMA step on rotations ``(J, 4)`` (or ``(..., J, 4)``), weights ``(J,)`` in [0, 1]."""
     weight = np.asarray(weight, float)[..., None]
-    sign = np.where(np.sum(previous * current, axis=-1, keepdims=True) < 0, -1.0, 1.0)
-    mixed = weight * sign * current + (1.0 - weight) * previous
-    norm = np.linalg.norm(mixed, axis=-1, keepdims=True)
+    # The new rotation's weight, signed into the previous one's hemisphere (w * -1 is -w).
+    signed = np.where(quat.dot(previous, current)[..., None] < 0, -weight, weight)
+    mixed = signed * current + (1.0 - weight) * previous
+    norm = np.sqrt(quat.dot(mixed, mixed))[..., None]  # np.linalg.norm's sum
     # Antipodal halfway points (norm 0) cannot happen after the sign flip; guard anyway.
     return np.where(norm > 1e-12, mixed / np.maximum(norm, 1e-12), previous)
 

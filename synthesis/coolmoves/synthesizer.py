@@ -28,16 +28,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import Skeleton, quat
+from avatar_models import Skeleton
 from avatar_models.body.description import UPRIGHT_RATIO
 from avatar_models.measure import standing_height
 from avatar_models.rigs import identify_rig
 from render_cams.vr import nominal_attachment
 from synthesis.base import FrameBatch, Poses, SynthesisError, Synthesizer
-from synthesis.coolmoves.alignment import alignment_yaw
+from synthesis.coolmoves.alignment import alignment_yaw, turn_about_vertical
 from synthesis.coolmoves.blend import (
     blend_rotations,
     global_match_weight,
+    group_shares,
     group_weights,
     joint_groups,
 )
@@ -50,7 +51,6 @@ from synthesis.coolmoves.smoothing import ewma
 from synthesis.two_bone import chain_fk
 from synthesis.two_bone import solve as two_bone
 
-_Z = np.array([0.0, 0.0, 1.0])
 EYE_HEIGHT_FRAC = 0.936
 ANKLE_HEIGHT_FRAC = 0.039
 """Eye and ankle heights over stature (Drillis & Contini 1966, the segment-length
@@ -181,6 +181,7 @@ class CoolMoves(Synthesizer):
         self.user_height_m = user_height_m
         self._matcher = self._make_matcher()
         self._groups = joint_groups(database.limb_masks)
+        self._group_shares = group_shares(self._groups)
         self._limits = JointLimits(database.skeleton, widen_to=database.poses)
         ref = database.skeleton
         rig = identify_rig(ref)
@@ -269,23 +270,19 @@ class CoolMoves(Synthesizer):
             of each joint ``(B, J)``: the global match weight where it got matches, else 0.
         """
         db, opts = self.database, self.options
-        queries = search_vectors(np.moveaxis(windows, 2, 1))  # (B, 2, F)
+        queries = search_vectors(windows.transpose(0, 2, 1, 3))  # (B, 2, F)
         dist, idx, match_weights = self._matcher.query(queries, tracked)
-        weights, confidence = group_weights(
-            dist[0], dist[1], opts.max_distance, match_weights[0], match_weights[1]
-        )
+        weights, confidence = group_weights(dist, opts.max_distance, match_weights)
         entries = np.concatenate([idx[0], idx[1]], axis=1)  # (B, 2k)
         safe = np.maximum(entries, 0)
-        rotations = db.poses[db.entry_pose[safe]]  # (B, 2k, J, 4)
+        rotations = db.poses[db.entry_pose[safe]]  # (B, 2k, J, 4), a copy (fancy index)
         if opts.align:
             yaw = alignment_yaw(windows, db.windows[safe], tracked, opts.align_about_centroid)
-            rotations = rotations.copy()
-            rotations[:, :, 0] = quat.mul(quat.from_axis_angle(_Z, yaw), rotations[:, :, 0])
-        joint_weights = weights[:, self._groups, :]  # (B, J, 2k)
-        blended = blend_rotations(rotations, joint_weights)
-        matched = joint_weights.sum(axis=-1) > 0
-        strength = global_match_weight(confidence, self._groups) if opts.smooth else 1.0
-        return blended, np.where(matched, np.reshape(strength, (-1, 1)), 0.0)
+            rotations[:, :, 0] = turn_about_vertical(rotations[:, :, 0], yaw)
+        blended = blend_rotations(rotations, weights[:, self._groups, :])  # (B, J, 4)
+        matched = (np.add.reduce(weights, axis=-1) > 0)[:, self._groups]  # (B, J)
+        strength = global_match_weight(confidence, self._group_shares) if opts.smooth else 1.0
+        return blended, np.where(matched, np.asarray(strength).reshape(-1, 1), 0.0)
 
     def _place(self, rotations: np.ndarray, hmd: np.ndarray, scale: np.ndarray) -> np.ndarray:
         """Root positions ``(B, 3)`` putting each pose's headset point at ``hmd (B, 3)``.
@@ -359,20 +356,26 @@ class CoolMoves(Synthesizer):
         padded_rel = np.concatenate([self._window[1:], rel])
         padded_ok = np.concatenate([self._tracked[1:], sides_ok])
         self._window, self._tracked = padded_rel[-n:], padded_ok[-n:]
-        ends = np.arange(n - 1, n - 1 + b)
-        windows = sliding_windows(padded_rel, ends, n)  # (B, n, 2, 3)
-        window_ok = sliding_windows(padded_ok, ends, n).all(axis=1)  # (B, 2)
-        rows = np.flatnonzero(window_ok.any(axis=1))
-        if rows.size == b:  # every frame has a window (a tracked stream, or one step)
+        if b == 1:  # one step: its window is the carried one (sliding_windows' single row)
+            windows, window_ok = padded_rel[None], padded_ok.all(axis=0)[None]
+        else:
+            ends = np.arange(n - 1, n - 1 + b)
+            windows = sliding_windows(padded_rel, ends, n)  # (B, n, 2, 3)
+            window_ok = sliding_windows(padded_ok, ends, n).all(axis=1)  # (B, 2)
+        has_window = window_ok.any(axis=1)
+        if has_window.all():  # every frame has a window (a tracked stream, or one step)
             blended, weight = self.match(windows, window_ok)
         else:  # frames without any window get no match: zero weight, the state holds
+            rows = np.flatnonzero(has_window)
             blended = np.zeros((b, self.database.skeleton.n_joints, 4))
             weight = np.zeros((b, self.database.skeleton.n_joints))
             if rows.size:
                 blended[rows], weight[rows] = self.match(windows[rows], window_ok[rows])
         # A joint's first match replaces the initial mean pose outright.
         matched = weight > 0
-        seen_before = np.concatenate([self._initialised[None], matched[:-1]]).cumsum(0) > 0
+        seen_before = np.logical_or.accumulate(
+            np.concatenate([self._initialised[None], matched[:-1]]), axis=0
+        )
         self._initialised = seen_before[-1] | matched[-1]
         smoothed = ewma(blended, np.where(seen_before, weight, matched), self._state)
         self._state = smoothed[-1]

@@ -20,23 +20,27 @@ def test_mul_rotate_conj_match_scipy():
     np.testing.assert_allclose(quat.angle(qa), a.magnitude(), atol=1e-12)
 
 
-def test_small_and_large_products_agree_to_the_bit():
-    """A step's few quaternions (the outer-product form) and a clip's (the component form,
-    above ``SMALL_PRODUCT``) give the same bits, as ``step`` must give what ``run`` gives;
-    both match scipy."""
+def test_mul_dot_cross_are_the_textbook_sums_to_the_bit():
+    """The hot-path forms (permuted components, no length-4 reductions) compute the textbook
+    expressions in the textbook order: streaming CoolMoves relies on bit-identical sums."""
     rng = np.random.default_rng(1)
-    a, b = Rotation.random(2000, random_state=rng), Rotation.random(2000, random_state=rng)
-    qa, qb = quat.from_scipy(a), quat.from_scipy(b)
-    assert qa.size + qb.size > quat.SMALL_PRODUCT
-    whole = quat.mul(qa, qb)
-    np.testing.assert_allclose(quat.to_matrix(whole), (a * b).as_matrix(), atol=1e-12)
-    for rows in (slice(0, 1), slice(5, 9), slice(10, 60)):
-        assert np.array_equal(quat.mul(qa[rows], qb[rows]), whole[rows])
-    # Broadcast shapes too: one rotation against many, a grid of pairs.
-    assert np.array_equal(quat.mul(qa[0], qb[:7]), quat.mul(np.tile(qa[0], (300, 1)), qb[:300])[:7])
-    grid = quat.mul(qa[:3, None], qb[None, :5])  # (3, 5, 4)
-    pairs = quat.mul(np.tile(np.repeat(qa[:3], 5, 0), (20, 1)), np.tile(qb[:5], (60, 1)))
-    assert np.array_equal(grid.reshape(15, 4), pairs[:15])
+    a, b = rng.normal(size=(2, 200, 4))
+    aw, ax, ay, az = a.T
+    bw, bx, by, bz = b.T
+    textbook = np.stack(
+        [
+            aw * bw - ax * bx - ay * by - az * bz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+        ],
+        axis=-1,
+    )
+    np.testing.assert_array_equal(quat.mul(a, b), textbook)
+    np.testing.assert_array_equal(quat.mul(a[0], b), quat.mul(np.broadcast_to(a[0], b.shape), b))
+    np.testing.assert_array_equal(quat.dot(a, b), np.sum(a * b, axis=-1))
+    u, v = a[:, 1:], b[:, 1:]
+    np.testing.assert_array_equal(quat.cross(u, v), np.cross(u, v))
 
 
 def test_power_is_scipy_slerp_step():

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from avatar_models import quat
 from avatar_models.generator import generate
+from avatar_models.motion import forward_kinematics
 from avatar_models.rigs import identify_rig, load_rig
 from render_cams import VRSetup
 from synthesis.base import TrackingFrame
@@ -27,6 +29,26 @@ def _arm(sk):
     rig = identify_rig(sk)
     joints = tuple(sk.index(rig.body17[f"l_{p}"]) for p in ("shoulder", "elbow", "wrist"))
     return joints, sk.chain(joints[-1])
+
+
+def test_chain_fk_is_the_rigs_forward_kinematics():
+    sk = load_rig("avatar").skeleton
+    rig = identify_rig(sk)
+    rng = np.random.default_rng(2)
+    rot = quat.from_scipy(Rotation.random(2 * sk.n_joints, random_state=3)).reshape(2, -1, 4)
+    root, scale = rng.normal(size=(2, 3)), np.array([0.9, 1.2])
+    chains = np.array([sk.chain(sk.index(rig.body17[f"{s}_wrist"])) for s in "lr"])
+    for b in range(2):
+        pos, glob = forward_kinematics(
+            sk.scaled(scale[b]), root[b : b + 1], quat.to_matrix(rot[b : b + 1])
+        )
+        globs, positions = chain_fk(rot, root, sk.offsets, scale, chains[0])
+        np.testing.assert_allclose(positions[b], pos[0, chains[0]], atol=1e-12)
+        np.testing.assert_allclose(globs[b], glob[0, chains[0]], atol=1e-12)
+        # Both arms in one pass: each the same as on its own.
+        globs, positions = chain_fk(rot, root, sk.offsets, scale, chains)
+        np.testing.assert_allclose(positions[b], pos[0, chains], atol=1e-12)
+        np.testing.assert_allclose(globs[b], glob[0, chains], atol=1e-12)
 
 
 @pytest.mark.parametrize("reach", [0.8, 1.5])

@@ -9,7 +9,7 @@ from avatar_models.library import MotionLibrary
 from avatar_models.rigs import body17_positions
 from render_cams import VRSetup
 from synthesis.base import TrackingFrame
-from synthesis.coolmoves import CoolMoves, build_database
+from synthesis.coolmoves import CoolMoves, Options, build_database
 from synthesis.coolmoves.applications import style_sub_library
 from synthesis.coolmoves.features import search_vectors, sliding_windows
 from synthesis.coolmoves.knn import KNNMatcher
@@ -63,10 +63,12 @@ def test_style_sub_library_changes_the_output(walks):
 
 
 @pytest.mark.mocap
-def test_stepping_a_real_clip_is_the_batch_run(walks):
+@pytest.mark.parametrize("arm_ik", [0.0, 1.0])  # the paper's pipeline, and arm IK on top
+def test_stepping_a_real_clip_is_the_batch_run(walks, arm_ik):
     """One core: a Bandai take stepped sample by sample is bit for bit the batch run."""
     truth = walks[("exhausted", 1)]
-    synth = CoolMoves(build_database([walks[("exhausted", 2)], walks[("youthful", 2)]]))
+    database = build_database([walks[("exhausted", 2)], walks[("youthful", 2)]])
+    synth = CoolMoves(database, options=Options(arm_ik=arm_ik))
     stream = VRSetup().sample(truth[: int(3 * truth.fps)], seed=0)
     batch = synth.run(stream)
     synth.reset()

@@ -10,7 +10,7 @@ from scipy.spatial.transform import Rotation
 from avatar_models import quat
 from avatar_models.rigs import load_rig
 from synthesis.coolmoves import correlation
-from synthesis.coolmoves.alignment import alignment_yaw, ramp_weights
+from synthesis.coolmoves.alignment import alignment_yaw, ramp_weights, turn_about_vertical
 from synthesis.coolmoves.blend import blend_rotations, group_weights, inverse_distance_weights
 from synthesis.coolmoves.features import (
     RATE_HZ,
@@ -20,7 +20,7 @@ from synthesis.coolmoves.features import (
     speed_windows,
     window_stride,
 )
-from synthesis.coolmoves.knn import K_NEIGHBOURS, KNNMatcher
+from synthesis.coolmoves.knn import K_NEIGHBOURS, BothHandsKNN, KNNMatcher
 from synthesis.coolmoves.limits import JointLimits
 from synthesis.coolmoves.smoothing import ewma, ewma_step
 from tests.synthesis.conftest import yaw_matrix
@@ -140,6 +140,13 @@ def test_knn_threshold_drops_far_matches_but_never_all(small_db):
 def test_knn_k_of_one(small_db):
     dist, idx, w = KNNMatcher(small_db.search[0], k=1).query(small_db.search[0][:3])
     assert dist.shape == idx.shape == w.shape == (3, 1) and np.all(w == 1.0)
+    # Both hands in one tree: database windows of each side find themselves, k = 1 too.
+    queries = np.stack([small_db.search[0][:3], small_db.search[1][5:8]], axis=1)  # (3, 2, F)
+    for k in (1, K_NEIGHBOURS):
+        dist, idx, _ = BothHandsKNN(small_db.search, k=k).query(queries, np.ones((3, 2), bool))
+        assert dist.shape == idx.shape == (2, 3, k)
+        np.testing.assert_array_equal(dist[:, :, 0], 0.0)
+        np.testing.assert_array_equal(idx[:, :, 0], [[0, 1, 2], [5, 6, 7]])
 
 
 @pytest.mark.parametrize("theta", [0.3, -1.2, 2.9, np.pi / 2])
@@ -154,6 +161,18 @@ def test_alignment_recovers_known_yaw(theta):
     # About the head (the default) a copy turned about the head is undone exactly.
     about_head = alignment_yaw(query, (query @ yaw_matrix(-theta).T)[:, None])
     assert about_head[0, 0] == pytest.approx(theta, abs=1e-9)
+
+
+def test_turning_matches_about_the_vertical_is_scipys_turn():
+    rng = np.random.default_rng(3)
+    poses = Rotation.random(60, random_state=4)
+    yaw = rng.uniform(-np.pi, np.pi, 60)
+    got = turn_about_vertical(quat.from_scipy(poses), yaw)
+    expected = Rotation.from_rotvec(yaw[:, None] * [0.0, 0.0, 1.0]) * poses
+    np.testing.assert_allclose(quat.to_matrix(got), expected.as_matrix(), atol=1e-12)
+    # The same numbers as the general product it shortens (streaming relies on it).
+    general = quat.mul(quat.from_axis_angle(np.array([0.0, 0, 1]), yaw), quat.from_scipy(poses))
+    np.testing.assert_array_equal(got, general)
 
 
 def test_alignment_about_head_keeps_forward_reach():
@@ -202,7 +221,7 @@ def test_inverse_distance_weights_by_hand():
 def test_group_weights_route_hands_to_their_arms():
     dl = np.array([[0.1, 0.2]])
     dr = np.array([[0.3, np.inf]])
-    weights, conf = group_weights(dl, dr, max_distance=0.5)
+    weights, conf = group_weights(np.stack([dl, dr]), max_distance=0.5)
     np.testing.assert_allclose(weights[0, 0], [2 / 3, 1 / 3, 0, 0], atol=1e-8)
     np.testing.assert_allclose(weights[0, 1], [0, 0, 1, 0], atol=1e-8)
     # Each match's likelihood t / (t + d): 0.5/0.6 and 0.5/0.7 on the left, 0.5/0.8 right.

@@ -45,9 +45,10 @@ def test_database_rejects_bad_input(train_motions):
         build_database(train_motions[:1], correlation_threshold=1.01)
 
 
-def test_streaming_equals_batch(small_db, stream):
-    # One core: stepping every sample is bit for bit the batch run, arm IK included.
-    synth = CoolMoves(small_db, TEST_SUBJECT.height_m, Options(arm_ik=1.0))
+@pytest.mark.parametrize("arm_ik", [0.0, 1.0])  # the paper's pipeline, and arm IK on top
+def test_streaming_equals_batch(small_db, stream, arm_ik):
+    # One core: stepping every sample is bit for bit the batch run.
+    synth = CoolMoves(small_db, TEST_SUBJECT.height_m, Options(arm_ik=arm_ik))
     batch = synth.run(stream)
     synth.reset()
     poses = [synth.step(TrackingFrame.from_stream(stream, i)) for i in range(stream.n_samples)]
