@@ -50,6 +50,9 @@ GRADIENT_STEP = 1e-4
 """Central-difference step in ``t``."""
 SETTLE_ITERATIONS = 150
 """Iterations of the first solve from the open hand (measured: converged by ~80)."""
+ETA_FLOOR = 1e-3 * LEARNING_RATE
+"""Least step size at the start of a frame's solve: a finger whose step collapsed probes
+again (our choice)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -153,7 +156,35 @@ class FingerIK:
         self.start, self.end = ends[:, None, 0], ends[:, None, 1]  # (F, 1, 3)
         self.thumb_button = thumb_button
         self.iterations_per_tick = int(iterations_per_tick)
+        self._first = self._first_solve()
         self.reset()
+
+    def _first_solve(self) -> tuple[np.ndarray, np.ndarray, bool]:
+        """``t (F, 3)``, the step sizes ``(F,)`` and whether converged after the first frame's
+        solve: :data:`SETTLE_ITERATIONS` steps from the open hand. The handles and the thumb
+        goal are fixed in the hand frames, so this is the same every session: solved once
+        here, at calibration, not in the first 90 Hz tick (~25 ms, two dropped frames)."""
+        self.reset()
+        self._eta = np.maximum(self._eta, ETA_FLOOR)
+        self.iterate(SETTLE_ITERATIONS)
+        return self.t, self._eta, self._converged
+
+    @property
+    def t(self) -> np.ndarray:
+        """``(F, 3)`` the current open-to-closed parameters."""
+        return self._t
+
+    @t.setter
+    def t(self, value: np.ndarray) -> None:
+        self._t = value
+        self._rotations: np.ndarray | None = None
+
+    def rotations(self) -> np.ndarray:
+        """``(F, 3, 4)`` :meth:`local_rotations` of the current ``t``, computed once per ``t``
+        (a settled hand holds its pose tick after tick)."""
+        if self._rotations is None:
+            self._rotations = self.local_rotations(self._t)
+        return self._rotations
 
     def reset(self) -> None:
         """Open hands, fresh step sizes."""
@@ -192,18 +223,22 @@ class FingerIK:
         return self.t
 
     def advance(self) -> np.ndarray:
-        """One frame's solve (the first settles from the open hand): ``t (F, 3)``.
+        """One frame's solve (the first settles from the open hand, solved once at
+        construction, :meth:`_first_solve`): ``t (F, 3)``.
 
         The handles sit still in the hand frames (:class:`~synthesis.avatargo.hands.Grip`)
         and the thumb goal is fixed, so the problem is the same every frame: once a round of
         steps improves no finger, the pose is held without probing (the 1 ms aim)."""
+        if not self._settled:  # the first frame: the solve from the open hand, stored
+            self._settled = True
+            t, eta, self._converged = self._first
+            self.t, self._eta = t.copy(), eta.copy()
+            return self.t
         if self._converged:
             return self.t
-        steps = self.iterations_per_tick if self._settled else SETTLE_ITERATIONS
-        self._settled = True
         # A finger whose step size collapsed has converged; let it probe again each frame.
-        self._eta = np.maximum(self._eta, 1e-3 * LEARNING_RATE)
-        return self.iterate(steps)
+        self._eta = np.maximum(self._eta, ETA_FLOOR)
+        return self.iterate(self.iterations_per_tick)
 
     def local_rotations(self, t: np.ndarray) -> np.ndarray:
         """``(..., F, 3, 4)`` wxyz local rotations of the finger joints for ``t (..., F, 3)``

@@ -386,10 +386,13 @@ class AvatarGo(Synthesizer):
         else:
             root_pos, local = self._solve_qp(pos, rot, seen)
         if self.finger_ik is not None:
-            fingers = np.stack([self.finger_ik.advance().copy() for _ in range(frames.size)])
-            rig = self.finger_ik.rig
+            fingers = self.finger_ik
+            rotations = []
+            for _ in range(frames.size):
+                fingers.advance()
+                rotations.append(fingers.rotations())
             local = local.copy()
-            local[:, rig.joints] = self.finger_ik.local_rotations(fingers)
+            local[:, fingers.rig.joints] = np.stack(rotations)
         return Poses(root_pos, local)
 
     def analytic_goals(self, positions: np.ndarray, quaternions: np.ndarray) -> AnalyticGoals:
