@@ -110,12 +110,14 @@ class AnalyticPose:
         local_rot: ``(B, J, 4)`` wxyz local rotations of the skeleton's joints.
         upper_pos: ``(B, 4, 3)`` hips and shoulders (:data:`LIMBS` order).
         end_pos: ``(B, 4, 3)`` where ankles and wrists ended (their goals where reachable).
+        end_mat: ``(B, 4, 3, 3)`` their world rotations (the goals'), as matrices.
     """
 
     root_pos: np.ndarray
     local_rot: np.ndarray
     upper_pos: np.ndarray
     end_pos: np.ndarray
+    end_mat: np.ndarray
 
 
 def path_between(parents, ancestor: int, joint: int) -> list[int]:
@@ -246,9 +248,11 @@ class AnalyticIK:
         chain_pos = np.stack([upper_pos, upper_pos, middle_pos, end_now], axis=2)
         # Goals nearer than the flexion limit or beyond the limb's length: the reachable
         # point on the way to the goal.
+        # (np.linalg.norm's and np.clip's arithmetic without their Python wrappers, whose
+        # set-up costs more than a tick's few vectors; likewise np.add.reduce for np.sum.)
         reach = end_pos - upper_pos
-        dist = np.linalg.norm(reach, axis=-1, keepdims=True)
-        clipped = np.clip(dist, self.reach[:, :1], self.reach[:, 1:])
+        dist = np.sqrt(np.add.reduce(reach * reach, axis=-1, keepdims=True))
+        clipped = np.minimum(np.maximum(dist, self.reach[:, :1]), self.reach[:, 1:])
         target = upper_pos + reach * (clipped / np.maximum(dist, 1e-12))
         local = two_bone(local, globs, chain_pos, self.limbs, target)
         # The pole (Unity's hint): each limb turned about its upper-to-end line until the
@@ -266,13 +270,15 @@ class AnalyticIK:
         straight = target[:, LEGS:] - straight - upper_pos[:, LEGS:]
         pole = np.concatenate([end_mat[:, :LEGS, :, 0], straight + POLE_NUDGE_M * elbows], 1)
         axis = target - upper_pos
-        axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
-        bent = bent - np.sum(bent * axis, -1, keepdims=True) * axis  # across the line
-        pole = pole - np.sum(pole * axis, -1, keepdims=True) * axis
-        swivel = np.arctan2(np.sum(quat.cross(bent, pole) * axis, -1), np.sum(bent * pole, -1))
+        axis /= np.sqrt(np.add.reduce(axis * axis, axis=-1, keepdims=True))
+        bent = bent - np.add.reduce(bent * axis, -1, keepdims=True) * axis  # across the line
+        pole = pole - np.add.reduce(pole * axis, -1, keepdims=True) * axis
+        swivel = np.arctan2(
+            np.add.reduce(quat.cross(bent, pole) * axis, -1), np.add.reduce(bent * pole, -1)
+        )
         turn = quat.from_axis_angle(axis, swivel)  # (B, 4, 4); a limb along its pole: ~0
         upper = quat.mul(turn, upper)
         local[:, limb[:, 0]] = quat.mul(quat.conj(parent), upper)
         middle = quat.mul(upper, local[:, limb[:, 1]])
         local[:, limb[:, 2]] = quat.mul(quat.conj(middle), end_rot)
-        return AnalyticPose(root_pos, local, upper_pos, target)
+        return AnalyticPose(root_pos, local, upper_pos, target, end_mat)

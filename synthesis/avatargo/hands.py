@@ -120,12 +120,13 @@ def palm_distance(
     """``(B, 2)`` metres from the palm's controller point of the solved wrists
     (``wrist_pos (B, 2, 3)``, rotation matrices ``wrist_rot (B, 2, 3, 3)``) to the tracked
     controllers ``(B, 2, 3)``."""
-    held = wrist_pos + (wrist_rot @ grip.palm[..., None])[..., 0]
-    return np.linalg.norm(held - controller_pos, axis=-1)
+    gap = wrist_pos + (wrist_rot @ grip.palm[..., None])[..., 0] - controller_pos
+    return np.sqrt(np.add.reduce(gap * gap, axis=-1))  # np.linalg.norm's sum (a tick's path)
 
 
 def out_of_reach(shoulders: np.ndarray, wrist_goals: np.ndarray, arm: np.ndarray) -> np.ndarray:
     """``(B, 2)`` whether each wrist goal ``(B, 2, 3)`` lies beyond the arm's length
     ``arm (2,)`` (plus :data:`REACH_SLACK_M`) from its shoulder ``(B, 2, 3)``: there the
     virtual controller is attached to the hand (§3.4)."""
-    return np.linalg.norm(wrist_goals - shoulders, axis=-1) > arm + REACH_SLACK_M
+    reach = wrist_goals - shoulders
+    return np.sqrt(np.add.reduce(reach * reach, axis=-1)) > arm + REACH_SLACK_M

@@ -172,8 +172,6 @@ def head_under(position: np.ndarray, rotation: np.ndarray, headset: Attachment) 
 def _first_usable(values: np.ndarray, ok: np.ndarray, last: np.ndarray) -> np.ndarray:
     """``values (B, D, n)`` with each unusable sample replaced by the device's latest usable
     one before it in the batch, or by ``last (D, n)`` (the previous batch's)."""
-    if ok.all():  # the common case: every device tracked (a per-tick fast path)
-        return values
     b = values.shape[0]
     latest = np.where(ok, np.arange(b)[:, None], -1)
     latest = np.maximum.accumulate(latest, axis=0)  # (B, D) index of the last usable sample
@@ -372,11 +370,14 @@ class AvatarGo(Synthesizer):
         index = self.device_index(frames)
         ok = frames.usable()[:, index]
         poses = np.concatenate([frames.positions[:, index], frames.quaternions[:, index]], -1)
-        last = np.concatenate([self._last_pos, self._last_rot], -1)
-        poses = _first_usable(poses, ok, last)  # (B, 6, 7) positions and rotations
+        if ok.all():  # the common case: every device tracked, and so seen (a per-tick fast path)
+            seen = np.ones(frames.size, bool)
+        else:
+            last = np.concatenate([self._last_pos, self._last_rot], -1)
+            poses = _first_usable(poses, ok, last)  # (B, 6, 7) positions and rotations
+            seen = np.isfinite(poses).all(-1).all(-1)  # every device tracked at least once
         pos, rot = poses[..., :3], poses[..., 3:]
         self._last_pos, self._last_rot = pos[-1], rot[-1]
-        seen = np.isfinite(pos).all(-1).all(-1)  # every device tracked at least once
         if not seen.all():  # NaN before a device is first seen
             pos = np.where(seen[:, None, None], pos, 0.0)
             rot = np.where(seen[:, None, None], rot, quat.IDENTITY)
@@ -404,13 +405,13 @@ class AvatarGo(Synthesizer):
         )  # head, feet, root, wrists
         # eq. 4's w_t: from the spine joint the bend turns (on the pelvis, eqs. 2-3) to the
         # head's centre (eqs. 2-3 of the headset); see synthesis.avatargo.spine.
-        pelvis_rot = quat.unit_to_matrix(joint_rot[:, 3])
-        w = joint_pos[:, 0] - joint_pos[:, 3] - pelvis_rot @ self.analytic.pelvis_to_spine
+        pelvis_mat = quat.unit_to_matrix(joint_rot[:, 3])
+        w = joint_pos[:, 0] - joint_pos[:, 3] - pelvis_mat @ self.analytic.pelvis_to_spine
         ends = [1, 2, 4, 5]  # ankles and wrists: the four limbs' goals (analytic_ik.LIMBS)
         return AnalyticGoals(
             joint_pos[:, 3],
             joint_rot[:, 3],
-            spine_bend_in_root(self._w0_in_root, w, joint_rot[:, 3]),
+            spine_bend_in_root(self._w0_in_root, w, pelvis_mat),
             joint_rot[:, 0],
             joint_pos[:, ends],
             joint_rot[:, ends],
@@ -424,9 +425,8 @@ class AvatarGo(Synthesizer):
         hand = [FULL_BODY.index(d) for d in HANDS]
         goals = self.analytic_goals(pos, rot)
         solved = self.analytic.solve(*goals)
-        wrist_pos, wrist_rot = goals.end_pos[:, LEGS:], goals.end_rot[:, LEGS:]
-        wrist = solved.end_pos[:, LEGS:]
-        palm = palm_distance(wrist, quat.unit_to_matrix(wrist_rot), pos[:, hand], self.grip)
+        wrist_pos, wrist_mat = goals.end_pos[:, LEGS:], solved.end_mat[:, LEGS:]
+        palm = palm_distance(solved.end_pos[:, LEGS:], wrist_mat, pos[:, hand], self.grip)
         reach = out_of_reach(solved.upper_pos[:, LEGS:], wrist_pos, self._arm_length)
         self.palm_distance.extend(palm[seen])
         self.attached.extend(reach[seen])

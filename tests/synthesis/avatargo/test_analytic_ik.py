@@ -109,7 +109,9 @@ def test_spine_inclines_by_eq4s_angle(body):
     w0 = quat.rotate(HEADING, head - pelvis)
     lateral = quat.rotate(HEADING, np.array([0.0, 1.0, 0.0]))
     w = quat.rotate(quat.from_axis_angle(lateral, np.array(np.radians(25.0))), w0)
-    bend = spine_bend_in_root(quat.rotate(quat.conj(HEADING), w0), w[None], HEADING[None])
+    bend = spine_bend_in_root(
+        quat.rotate(quat.conj(HEADING), w0), w[None], quat.unit_to_matrix(HEADING[None])
+    )
     assert np.degrees(bend_angle(w0, w[None]))[0] == pytest.approx(25.0)
     ends = np.zeros((1, 4, 3))  # unreachable: only the spine matters here
     pos, _ = solved(ik, body, standing_goals(body, ends, bend))
