@@ -35,7 +35,7 @@ def from_scipy(r: Rotation, shape: tuple[int, ...] | None = None) -> np.ndarray:
 def normalize(q: np.ndarray) -> np.ndarray:
     """Unit quaternions, sign chosen with ``w >= 0``."""
     q = np.asarray(q, dtype=float)
-    q = q / np.linalg.norm(q, axis=-1, keepdims=True)
+    q = q / np.sqrt(np.add.reduce(q * q, axis=-1, keepdims=True))  # np.linalg.norm's sum
     return np.where(q[..., :1] < 0, -q, q)
 
 

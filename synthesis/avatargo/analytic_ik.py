@@ -237,9 +237,11 @@ class AnalyticIK:
         local[:, self.spine] = spine_bend
         local[:, self.head] = quat.mul(quat.conj(glob[:, self.head_anchor]), head_rot)
 
-        parent = glob[:, self.upper_anchor]  # (B, 4, 4) hips' and shoulders' parents
-        parent_mat = mats[:, self.upper_anchor]
-        upper_pos = pos[:, self.upper_anchor] + (parent_mat @ self.upper_offsets[..., None])[..., 0]
+        # (np.take: the gather of x[:, index] without advanced indexing's set-up.)
+        parent = np.take(glob, self.upper_anchor, axis=1)  # (B, 4, 4) hips' and shoulders' parents
+        parent_mat = np.take(mats, self.upper_anchor, axis=1)
+        upper_pos = np.take(pos, self.upper_anchor, axis=1)
+        upper_pos = upper_pos + (parent_mat @ self.upper_offsets[..., None])[..., 0]
         # The rest limbs, each middle joint pre-bent about its hinge (the bend plane).
         middle_mat = quat.unit_to_matrix(quat.mul(parent, self.pre_bend))
         middle_pos = upper_pos + (parent_mat @ self.upper_bones[..., None])[..., 0]
@@ -258,7 +260,7 @@ class AnalyticIK:
         # The pole (Unity's hint): each limb turned about its upper-to-end line until the
         # knee or elbow points as near as it can to it.
         limb = self.limbs
-        upper = quat.mul(parent, local[:, limb[:, 0]])
+        upper = quat.mul(parent, np.take(local, limb[:, 0], axis=1))
         bent = (quat.unit_to_matrix(upper) @ self.upper_bones[..., None])[..., 0]
         # Knees: where the feet point (their goals' +X). Elbows: where the elbow would be
         # with the wrist straight (the hand's goal rotation carrying the forearm), nudged
@@ -279,6 +281,6 @@ class AnalyticIK:
         turn = quat.from_axis_angle(axis, swivel)  # (B, 4, 4); a limb along its pole: ~0
         upper = quat.mul(turn, upper)
         local[:, limb[:, 0]] = quat.mul(quat.conj(parent), upper)
-        middle = quat.mul(upper, local[:, limb[:, 1]])
+        middle = quat.mul(upper, np.take(local, limb[:, 1], axis=1))
         local[:, limb[:, 2]] = quat.mul(quat.conj(middle), end_rot)
         return AnalyticPose(root_pos, local, upper_pos, target, end_mat)

@@ -95,6 +95,14 @@ the order of :data:`TRACKED` (head, feet, root), then the spine and the wrists."
 TRACKED = ("hmd", "left_foot_tracker", "right_foot_tracker", "back_tracker")
 """Devices with a tracker-to-joint offset (eqs. 2-3), one per site of :data:`SITES`."""
 HANDS = ("left_controller", "right_controller")
+HAND_DEVICES = np.array([FULL_BODY.index(d) for d in HANDS])
+"""Role-order indices (:data:`~render_cams.vr.FULL_BODY`) of :data:`HANDS`."""
+ANALYTIC_DEVICES = np.array([FULL_BODY.index(d) for d in (*TRACKED, *HANDS)])
+"""Role-order indices of the devices of the analytic solver's joints: head, feet, root
+(:data:`TRACKED`), wrists (:data:`HANDS`)."""
+LIMB_ENDS = np.array([1, 2, 4, 5])
+"""The ankles and wrists in that order: the four limbs' goals (:data:`~synthesis.avatargo.
+analytic_ik.LIMBS`)."""
 POSITION_COST = np.array([10.0, 10.0, 10.0, 10.0, 0.3, 10.0, 10.0])
 ORIENTATION_COST = np.array([0.1, 1.0, 1.0, 1.0, 0.0, 0.03, 0.03])
 """Head, feet, root and wrists are the paper's goals (Unity IK effectors plus root and head,
@@ -368,8 +376,11 @@ class AvatarGo(Synthesizer):
         """The analytic solver on the whole batch at once, or the QP solvers' goals for the
         batch, then one warm-started solve per frame; the fingers frame by frame."""
         index = self.device_index(frames)
-        ok = frames.usable()[:, index]
-        poses = np.concatenate([frames.positions[:, index], frames.quaternions[:, index]], -1)
+        ok = np.take(frames.usable(), index, axis=1)  # x[:, index] without its set-up
+        poses = np.concatenate(
+            [np.take(frames.positions, index, axis=1), np.take(frames.quaternions, index, axis=1)],
+            -1,
+        )
         if ok.all():  # the common case: every device tracked, and so seen (a per-tick fast path)
             seen = np.ones(frames.size, bool)
         else:
@@ -399,22 +410,21 @@ class AvatarGo(Synthesizer):
     def analytic_goals(self, positions: np.ndarray, quaternions: np.ndarray) -> AnalyticGoals:
         """The analytic solver's goals for device poses ``positions (B, 6, 3)``, unit
         ``quaternions (B, 6, 4)`` in role order (eqs. 2-4 and the palm offsets)."""
-        devices = [FULL_BODY.index(d) for d in (*TRACKED, *HANDS)]
         joint_pos, joint_rot = self._joint_offsets.joint_poses(
-            positions[:, devices], quaternions[:, devices]
-        )  # head, feet, root, wrists
+            np.take(positions, ANALYTIC_DEVICES, axis=1),
+            np.take(quaternions, ANALYTIC_DEVICES, axis=1),
+        )  # head, feet, root, wrists (np.take: x[:, index] without its set-up)
         # eq. 4's w_t: from the spine joint the bend turns (on the pelvis, eqs. 2-3) to the
         # head's centre (eqs. 2-3 of the headset); see synthesis.avatargo.spine.
         pelvis_mat = quat.unit_to_matrix(joint_rot[:, 3])
         w = joint_pos[:, 0] - joint_pos[:, 3] - pelvis_mat @ self.analytic.pelvis_to_spine
-        ends = [1, 2, 4, 5]  # ankles and wrists: the four limbs' goals (analytic_ik.LIMBS)
         return AnalyticGoals(
             joint_pos[:, 3],
             joint_rot[:, 3],
             spine_bend_in_root(self._w0_in_root, w, pelvis_mat),
             joint_rot[:, 0],
-            joint_pos[:, ends],
-            joint_rot[:, ends],
+            np.take(joint_pos, LIMB_ENDS, axis=1),
+            np.take(joint_rot, LIMB_ENDS, axis=1),
         )
 
     def _solve_analytic(self, pos: np.ndarray, rot: np.ndarray, seen: np.ndarray):
@@ -422,11 +432,11 @@ class AvatarGo(Synthesizer):
         :class:`~synthesis.avatargo.analytic_ik.AnalyticIK` for the role-ordered device
         poses ``pos (B, 6, 3)``, ``rot (B, 6, 4)``; the walk-in T-pose where not ``seen``."""
         cal = self.calibration
-        hand = [FULL_BODY.index(d) for d in HANDS]
         goals = self.analytic_goals(pos, rot)
         solved = self.analytic.solve(*goals)
         wrist_pos, wrist_mat = goals.end_pos[:, LEGS:], solved.end_mat[:, LEGS:]
-        palm = palm_distance(solved.end_pos[:, LEGS:], wrist_mat, pos[:, hand], self.grip)
+        controllers = np.take(pos, HAND_DEVICES, axis=1)
+        palm = palm_distance(solved.end_pos[:, LEGS:], wrist_mat, controllers, self.grip)
         reach = out_of_reach(solved.upper_pos[:, LEGS:], wrist_pos, self._arm_length)
         self.palm_distance.extend(palm[seen])
         self.attached.extend(reach[seen])
