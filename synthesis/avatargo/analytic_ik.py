@@ -227,27 +227,34 @@ class AnalyticIK:
         # every other joint hangs from one of them unrotated), as quaternions for the
         # outputs and as matrices for the positions (one matrix product each; numpy's
         # per-call overhead, not the arithmetic, is the cost of these few vectors).
-        glob = np.stack([pelvis_rot, quat.mul(pelvis_rot, spine_bend)], axis=1)  # (B, 2, 4)
+        # (Stacks by np.concatenate of views: np.stack's Python set-up costs more than a
+        # tick's few vectors; likewise x.take(index, axis) for x[:, index].)
+        spine_rot = quat.mul(pelvis_rot, spine_bend)
+        glob = np.concatenate([pelvis_rot[:, None], spine_rot[:, None]], axis=1)  # (B, 2, 4)
         mats = quat.unit_to_matrix(glob)  # (B, 2, 3, 3)
         root_pos = pelvis_pos - (mats[:, 0] @ self.root_to_pelvis)
-        pos = np.stack([root_pos, root_pos + mats[:, 0] @ self.root_to_spine], axis=1)
+        spine_pos = root_pos + mats[:, 0] @ self.root_to_spine
+        pos = np.concatenate([root_pos[:, None], spine_pos[:, None]], axis=1)
 
         local = np.repeat(self.template[None], b, axis=0)
         local[:, 0] = pelvis_rot
         local[:, self.spine] = spine_bend
         local[:, self.head] = quat.mul(quat.conj(glob[:, self.head_anchor]), head_rot)
 
-        # (np.take: the gather of x[:, index] without advanced indexing's set-up.)
-        parent = np.take(glob, self.upper_anchor, axis=1)  # (B, 4, 4) hips' and shoulders' parents
-        parent_mat = np.take(mats, self.upper_anchor, axis=1)
-        upper_pos = np.take(pos, self.upper_anchor, axis=1)
+        parent = glob.take(self.upper_anchor, axis=1)  # (B, 4, 4) hips' and shoulders' parents
+        parent_mat = mats.take(self.upper_anchor, axis=1)
+        upper_pos = pos.take(self.upper_anchor, axis=1)
         upper_pos = upper_pos + (parent_mat @ self.upper_offsets[..., None])[..., 0]
         # The rest limbs, each middle joint pre-bent about its hinge (the bend plane).
         middle_mat = quat.unit_to_matrix(quat.mul(parent, self.pre_bend))
         middle_pos = upper_pos + (parent_mat @ self.upper_bones[..., None])[..., 0]
         end_now = middle_pos + (middle_mat @ self.lower_bones[..., None])[..., 0]
-        globs = np.stack([parent_mat, parent_mat, middle_mat, middle_mat], 2)  # end's unused
-        chain_pos = np.stack([upper_pos, upper_pos, middle_pos, end_now], axis=2)
+        globs = np.concatenate(
+            [m[:, :, None] for m in (parent_mat, parent_mat, middle_mat, middle_mat)], 2
+        )  # end's unused
+        chain_pos = np.concatenate(
+            [p[:, :, None] for p in (upper_pos, upper_pos, middle_pos, end_now)], 2
+        )
         # Goals nearer than the flexion limit or beyond the limb's length: the reachable
         # point on the way to the goal.
         # (np.linalg.norm's and np.clip's arithmetic without their Python wrappers, whose
@@ -260,7 +267,7 @@ class AnalyticIK:
         # The pole (Unity's hint): each limb turned about its upper-to-end line until the
         # knee or elbow points as near as it can to it.
         limb = self.limbs
-        upper = quat.mul(parent, np.take(local, limb[:, 0], axis=1))
+        upper = quat.mul(parent, local.take(limb[:, 0], axis=1))
         bent = (quat.unit_to_matrix(upper) @ self.upper_bones[..., None])[..., 0]
         # Knees: where the feet point (their goals' +X). Elbows: where the elbow would be
         # with the wrist straight (the hand's goal rotation carrying the forearm), nudged
@@ -281,6 +288,6 @@ class AnalyticIK:
         turn = quat.from_axis_angle(axis, swivel)  # (B, 4, 4); a limb along its pole: ~0
         upper = quat.mul(turn, upper)
         local[:, limb[:, 0]] = quat.mul(quat.conj(parent), upper)
-        middle = quat.mul(upper, np.take(local, limb[:, 1], axis=1))
+        middle = quat.mul(upper, local.take(limb[:, 1], axis=1))
         local[:, limb[:, 2]] = quat.mul(quat.conj(middle), end_rot)
         return AnalyticPose(root_pos, local, upper_pos, target, end_mat)

@@ -376,9 +376,9 @@ class AvatarGo(Synthesizer):
         """The analytic solver on the whole batch at once, or the QP solvers' goals for the
         batch, then one warm-started solve per frame; the fingers frame by frame."""
         index = self.device_index(frames)
-        ok = np.take(frames.usable(), index, axis=1)  # x[:, index] without its set-up
+        ok = frames.usable().take(index, axis=1)  # x[:, index] without its set-up
         poses = np.concatenate(
-            [np.take(frames.positions, index, axis=1), np.take(frames.quaternions, index, axis=1)],
+            [frames.positions.take(index, axis=1), frames.quaternions.take(index, axis=1)],
             -1,
         )
         if ok.all():  # the common case: every device tracked, and so seen (a per-tick fast path)
@@ -411,9 +411,9 @@ class AvatarGo(Synthesizer):
         """The analytic solver's goals for device poses ``positions (B, 6, 3)``, unit
         ``quaternions (B, 6, 4)`` in role order (eqs. 2-4 and the palm offsets)."""
         joint_pos, joint_rot = self._joint_offsets.joint_poses(
-            np.take(positions, ANALYTIC_DEVICES, axis=1),
-            np.take(quaternions, ANALYTIC_DEVICES, axis=1),
-        )  # head, feet, root, wrists (np.take: x[:, index] without its set-up)
+            positions.take(ANALYTIC_DEVICES, axis=1),
+            quaternions.take(ANALYTIC_DEVICES, axis=1),
+        )  # head, feet, root, wrists (x.take: x[:, index] without its set-up)
         # eq. 4's w_t: from the spine joint the bend turns (on the pelvis, eqs. 2-3) to the
         # head's centre (eqs. 2-3 of the headset); see synthesis.avatargo.spine.
         pelvis_mat = quat.unit_to_matrix(joint_rot[:, 3])
@@ -423,8 +423,8 @@ class AvatarGo(Synthesizer):
             joint_rot[:, 3],
             spine_bend_in_root(self._w0_in_root, w, pelvis_mat),
             joint_rot[:, 0],
-            np.take(joint_pos, LIMB_ENDS, axis=1),
-            np.take(joint_rot, LIMB_ENDS, axis=1),
+            joint_pos.take(LIMB_ENDS, axis=1),
+            joint_rot.take(LIMB_ENDS, axis=1),
         )
 
     def _solve_analytic(self, pos: np.ndarray, rot: np.ndarray, seen: np.ndarray):
@@ -435,7 +435,7 @@ class AvatarGo(Synthesizer):
         goals = self.analytic_goals(pos, rot)
         solved = self.analytic.solve(*goals)
         wrist_pos, wrist_mat = goals.end_pos[:, LEGS:], solved.end_mat[:, LEGS:]
-        controllers = np.take(pos, HAND_DEVICES, axis=1)
+        controllers = pos.take(HAND_DEVICES, axis=1)
         palm = palm_distance(solved.end_pos[:, LEGS:], wrist_mat, controllers, self.grip)
         reach = out_of_reach(solved.upper_pos[:, LEGS:], wrist_pos, self._arm_length)
         self.palm_distance.extend(palm[seen])
