@@ -231,7 +231,12 @@ class AnalyticIK:
         # tick's few vectors; likewise x.take(index, axis) for x[:, index].)
         spine_rot = quat.mul(pelvis_rot, spine_bend)
         glob = np.concatenate([pelvis_rot[:, None], spine_rot[:, None]], axis=1)  # (B, 2, 4)
-        mats = quat.unit_to_matrix(glob)  # (B, 2, 3, 3)
+        parent = glob.take(self.upper_anchor, axis=1)  # (B, 4, 4) hips' and shoulders' parents
+        # One matrix conversion for the anchors, the rest limbs' middle joints pre-bent about
+        # their hinges (the bend planes) and the ends' goals.
+        middle_rot = quat.mul(parent, self.pre_bend)
+        mats = quat.unit_to_matrix(np.concatenate([glob, middle_rot, end_rot], axis=1))
+        mats, middle_mat, end_mat = mats[:, :2], mats[:, 2:6], mats[:, 6:]  # (B, n, 3, 3)
         root_pos = pelvis_pos - (mats[:, 0] @ self.root_to_pelvis)
         spine_pos = root_pos + mats[:, 0] @ self.root_to_spine
         pos = np.concatenate([root_pos[:, None], spine_pos[:, None]], axis=1)
@@ -241,12 +246,9 @@ class AnalyticIK:
         local[:, self.spine] = spine_bend
         local[:, self.head] = quat.mul(quat.conj(glob[:, self.head_anchor]), head_rot)
 
-        parent = glob.take(self.upper_anchor, axis=1)  # (B, 4, 4) hips' and shoulders' parents
         parent_mat = mats.take(self.upper_anchor, axis=1)
         upper_pos = pos.take(self.upper_anchor, axis=1)
         upper_pos = upper_pos + (parent_mat @ self.upper_offsets[..., None])[..., 0]
-        # The rest limbs, each middle joint pre-bent about its hinge (the bend plane).
-        middle_mat = quat.unit_to_matrix(quat.mul(parent, self.pre_bend))
         middle_pos = upper_pos + (parent_mat @ self.upper_bones[..., None])[..., 0]
         end_now = middle_pos + (middle_mat @ self.lower_bones[..., None])[..., 0]
         globs = np.concatenate(
@@ -273,7 +275,6 @@ class AnalyticIK:
         # with the wrist straight (the hand's goal rotation carrying the forearm), nudged
         # towards down and back for an arm straight in the hand's goal (that point then
         # lies on the line).
-        end_mat = quat.unit_to_matrix(end_rot)  # (B, 4, 3, 3)
         elbows = (parent_mat[:, LEGS:] @ self.elbow_poles[..., None])[..., 0]  # (B, 2, 3)
         straight = (end_mat[:, LEGS:] @ self.lower_bones[LEGS:, :, None])[..., 0]
         straight = target[:, LEGS:] - straight - upper_pos[:, LEGS:]

@@ -39,7 +39,7 @@ def bend_angle(w0: np.ndarray, w: np.ndarray) -> np.ndarray:
 def spine_bend(w0: np.ndarray, w: np.ndarray) -> np.ndarray:
     """``(B, 4)`` wxyz rotations by ``alpha_t`` about ``w0 x w_t`` (identity where parallel):
     each turns the direction of ``w0 (3,)`` onto that of ``w (B, 3)``, the shortest arc."""
-    return shortest_arc(np.broadcast_to(w0, np.shape(w)), w)
+    return shortest_arc(w0, w)  # broadcasts
 
 
 def spine_bend_in_root(w0_in_root: np.ndarray, w: np.ndarray, root_mat: np.ndarray) -> np.ndarray:
