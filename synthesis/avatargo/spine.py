@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import quat
 from synthesis.two_bone import shortest_arc
 
 

@@ -27,9 +27,10 @@ Each tick (§3.4), by the per-tick IK ``solver`` (:data:`SOLVERS`):
   spine_bend_in_root`), the head turned as the headset, and closed-form two-bone limbs
   (:mod:`synthesis.two_bone`) onto the ankles' goals (eqs. 2-3) and the wrists' under the
   controllers, the ankles and wrists at their goal rotations. Vectorised over a batch's
-  frames. ``avatarsim bench avatargo`` on the shared 2-core machine (load average 3-4):
-  CPU time per tick p50 1.1 ms, p99 1.9-2.5 ms, against mink's 1.9-2.1 / 3.7-4.0 ms (the
-  1 ms p99 aim is not shown there). Feet and root on their goals: built-in study (30
+  frames. ``avatarsim bench avatargo`` on the shared 2-core machine (load average 3.9-4.1,
+  three runs): CPU time per tick p50 0.74-1.26 ms, p99 1.23-1.89 ms, against mink's
+  1.9-2.2 / 3.0-4.0 ms (the 1 ms p99 aim is not shown there; the tail is the machine's,
+  see :mod:`scripts.benchmarks.avatargo`). Feet and root on their goals: built-in study (30
   users, realistic noise) 0.67 / 0.62 cm mean, against mink's 1.4-1.7 / 2.2 cm; the head
   by forward kinematics 0.63 cm (mink 0.68).
 - ``"mink"`` or ``"least-squares"`` (:data:`QP_SOLVERS`): full-body IK on the avatar's
