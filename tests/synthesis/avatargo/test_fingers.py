@@ -44,3 +44,19 @@ def test_thumb_button_pulls_the_thumb():
     tips = [ik.sdf(ik.advance()) for ik in (free, pressing)]
     assert not np.allclose(pressing.t[[0, 5]], free.t[[0, 5]])
     assert tips[1].min() > -0.002
+
+
+def test_every_session_starts_with_the_hands_on_the_handle():
+    """The first frame's solve is done once, at construction: after a reset, whatever the
+    last session left (here a hand opened and three steps from open), the first frame again
+    holds the first session's grip, every finger within 2 mm of the handle's surface."""
+    skeleton = load_rig("avatar").skeleton
+    ik = FingerIK(skeleton, grip_of(skeleton))
+    first = ik.advance().copy()
+    ik.reset()
+    assert not ik.t.any()  # open hands
+    ik.iterate(3)
+    ik.reset()
+    again = ik.advance()
+    np.testing.assert_array_equal(again, first)
+    assert np.abs(ik.sdf(again).min(-1)).max() < 0.002
