@@ -305,12 +305,14 @@ class CoolMoves(Synthesizer):
     ) -> tuple[np.ndarray, np.ndarray]:
         """Final rotations ``(B, J, 4)`` and roots ``(B, 3)``: limits, placement, arm IK.
 
-        ``hands (B, 2, 3)`` are the tracked world driver positions, ``hands_ok (B, 2)``.
+        ``hands (B, 2, 3)`` are the world driver positions, usable where ``hands_ok (B, 2)``
+        (elsewhere any value, NaN included: only arm IK reads them).
         """
         clamp = self._limits.clamp if self.options.clamp else (lambda r: r)
         rotations = clamp(smoothed)
         root = self._place(rotations, hmd, scale)
         if self.options.arm_ik > 0 and hands_ok.any():
+            hands = np.where(hands_ok[..., None], hands, 0.0)  # NaN-free: weight 0 there
             for sides, arm in self._arms:
                 side = sides if arm.joints.ndim == 2 else sides[0]
                 weight = np.where(hands_ok[:, side], self.options.arm_ik, 0.0)
@@ -383,8 +385,7 @@ class CoolMoves(Synthesizer):
         smoothed = ewma(blended, np.where(seen_before, weight, matched), self._state)
         self._state = smoothed[-1]
         hmd, scale = self._hmd_track(drivers[:, 0], ok[:, 0])
-        hands = np.where(sides_ok[..., None], drivers[:, 1:], 0.0)
-        rotations, root = self._finish(smoothed, hmd, scale, hands, sides_ok)
+        rotations, root = self._finish(smoothed, hmd, scale, drivers[:, 1:], sides_ok)
         return Poses(root, rotations)
 
     def _hmd_track(self, hmd: np.ndarray, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
