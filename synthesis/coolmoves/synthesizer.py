@@ -305,12 +305,14 @@ class CoolMoves(Synthesizer):
     ) -> tuple[np.ndarray, np.ndarray]:
         """Final rotations ``(B, J, 4)`` and roots ``(B, 3)``: limits, placement, arm IK.
 
-        ``hands (B, 2, 3)`` are the tracked world driver positions, ``hands_ok (B, 2)``.
+        ``hands (B, 2, 3)`` are the world driver positions, usable where ``hands_ok (B, 2)``
+        (elsewhere any value, NaN included: only arm IK reads them).
         """
         clamp = self._limits.clamp if self.options.clamp else (lambda r: r)
         rotations = clamp(smoothed)
         root = self._place(rotations, hmd, scale)
         if self.options.arm_ik > 0 and hands_ok.any():
+            hands = np.where(hands_ok[..., None], hands, 0.0)  # NaN-free: weight 0 there
             for sides, arm in self._arms:
                 side = sides if arm.joints.ndim == 2 else sides[0]
                 weight = np.where(hands_ok[:, side], self.options.arm_ik, 0.0)
@@ -373,20 +375,24 @@ class CoolMoves(Synthesizer):
                 blended[rows], weight[rows] = self.match(windows[rows], window_ok[rows])
         # A joint's first match replaces the initial mean pose outright.
         matched = weight > 0
-        seen_before = np.logical_or.accumulate(
-            np.concatenate([self._initialised[None], matched[:-1]]), axis=0
-        )
+        if b == 1:  # one step: what the running "or" over the batch's earlier frames gives
+            seen_before = self._initialised[None]
+        else:
+            seen_before = np.logical_or.accumulate(
+                np.concatenate([self._initialised[None], matched[:-1]]), axis=0
+            )
         self._initialised = seen_before[-1] | matched[-1]
         smoothed = ewma(blended, np.where(seen_before, weight, matched), self._state)
         self._state = smoothed[-1]
         hmd, scale = self._hmd_track(drivers[:, 0], ok[:, 0])
-        hands = np.where(sides_ok[..., None], drivers[:, 1:], 0.0)
-        rotations, root = self._finish(smoothed, hmd, scale, hands, sides_ok)
+        rotations, root = self._finish(smoothed, hmd, scale, drivers[:, 1:], sides_ok)
         return Poses(root, rotations)
 
     def _hmd_track(self, hmd: np.ndarray, ok: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Last tracked headset position per frame ``(B, 3)`` (before any: the one carried
         from earlier batches, else the rig's standing headset) and the bone scale ``(B,)``."""
+        if ok.size == 1:  # one step: the same numbers without the running maximum over frames
+            return self._hmd_step(hmd, bool(ok[0]))
         last = np.maximum.accumulate(np.where(ok, np.arange(ok.size), -1))
         before = self._default_hmd() if self._hmd is None else self._hmd
         held = np.where((last >= 0)[:, None], hmd[np.maximum(last, 0)], before)
@@ -399,3 +405,21 @@ class CoolMoves(Synthesizer):
         if seen[-1]:
             self._hmd = held[-1]
         return held, scale
+
+    def _hmd_step(self, hmd: np.ndarray, ok: bool) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`_hmd_track` of one frame ``hmd (1, 3)`` (a step costs a few scalar tests
+        where the batch form takes a dozen numpy calls)."""
+        if ok:
+            held = hmd
+            if self._scale is None:
+                self._scale = self._scale_from_hmd(float(hmd[0, 2]))
+        else:
+            held = (self._default_hmd() if self._hmd is None else self._hmd)[None]
+        seen = ok or self._hmd is not None
+        if self.user_height_m is not None:
+            scale = self._scale
+        else:
+            scale = (self._scale or 1.0) if seen else 1.0
+        if seen:
+            self._hmd = held[-1]
+        return held, np.array([scale], float)
