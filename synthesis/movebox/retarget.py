@@ -46,15 +46,6 @@ BEND_FADE = (0.1, 0.3)
 knee has no bend plane (our choice)."""
 
 
-def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a x b`` over ``(..., 3)``, written out: ``np.cross`` moves axes on every call, which
-    dominated a streaming step (one Kinect frame, ~40 small crosses)."""
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
-
-
 def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Unit quaternions ``q (..., 4)`` applied to ``v (..., 3)`` (or one ``(3,)``), through
     :func:`avatar_models.quat.unit_to_matrix` (no cross products)."""
@@ -72,9 +63,9 @@ def shortest_arc(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     u = u / np.maximum(nu, 1e-12)
     v = v / np.maximum(nv, 1e-12)
     w = 1.0 + np.sum(u * v, axis=-1)
-    axis = cross(u, v)
+    axis = quat.cross(u, v)
     opposite = w < 1e-9
-    perpendicular = cross(u, np.where(np.abs(u[..., :1]) < 0.9, [1.0, 0, 0], [0, 1.0, 0]))
+    perpendicular = quat.cross(u, np.where(np.abs(u[..., :1]) < 0.9, [1.0, 0, 0], [0, 1.0, 0]))
     axis = np.where(opposite[..., None], perpendicular, axis)
     q = np.concatenate([np.where(opposite, 0.0, w)[..., None], axis], axis=-1)
     q = np.where(degenerate[..., None], quat.IDENTITY, q)
@@ -86,13 +77,13 @@ def frame_from_pair(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     z along ``a x b``; the identity where they are (near) parallel or zero (a garbage frame
     must not stop the stream)."""
     x = a + b
-    z = cross(a, b)
+    z = quat.cross(a, b)
     nx = np.linalg.norm(x, axis=-1, keepdims=True)
     nz = np.linalg.norm(z, axis=-1, keepdims=True)
     ok = (nx > 1e-9) & (nz > 1e-9)
     x = np.where(ok, x / np.maximum(nx, 1e-12), [1.0, 0.0, 0.0])
     z = np.where(ok, z / np.maximum(nz, 1e-12), [0.0, 0.0, 1.0])
-    return np.stack([x, cross(z, x), z], axis=-1)
+    return np.stack([x, quat.cross(z, x), z], axis=-1)
 
 
 def twist_angle(q: np.ndarray, axis: np.ndarray) -> np.ndarray:
@@ -246,7 +237,7 @@ class Retargeting:
         seen = rotate(quat.conj(world), positions[:, self.kinect_index(child.aim)] - end)
         seen_perp = seen - np.sum(seen * axis, -1, keepdims=True) * axis
         bend = np.asarray(drive.bend) - np.dot(drive.bend, axis) * axis
-        angle = np.arctan2(cross(bend, seen_perp) @ axis, seen_perp @ bend)
+        angle = np.arctan2(quat.cross(bend, seen_perp) @ axis, seen_perp @ bend)
         sine = np.linalg.norm(seen_perp, axis=-1) / np.maximum(np.linalg.norm(seen, axis=-1), 1e-12)
         lo, hi = BEND_FADE
         weight = np.clip((sine - lo) / (hi - lo), 0.0, 1.0)
