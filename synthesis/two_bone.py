@@ -64,15 +64,22 @@ def _norm(v: np.ndarray) -> np.ndarray:
     return np.sqrt(np.add.reduce(v * v, axis=-1, keepdims=True))
 
 
-def _unit(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def unit(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Directions ``(..., 3)`` and lengths ``(...)`` of vectors ``v (..., 3)`` (a zero vector
+    stays zero): the normalisation :func:`shortest_arc` applies, for callers that pass
+    :func:`unit_arc` directions they already have."""
     norm = _norm(v)
     return v / np.maximum(norm, _EPS), norm[..., 0]
 
 
 def shortest_arc(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``(..., 4)`` smallest rotations turning directions ``a`` onto ``b`` ``(..., 3)``."""
-    a, _ = _unit(a)
-    b, _ = _unit(b)
+    return unit_arc(unit(a)[0], unit(b)[0])
+
+
+def unit_arc(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """:func:`shortest_arc` of directions ``a``, ``b`` ``(..., 3)`` already normalised by
+    :func:`unit` (normalising twice would change the last bits)."""
     cos = np.add.reduce(a * b, axis=-1, keepdims=True)
     q = np.concatenate([1.0 + cos, quat.cross(a, b)], axis=-1)
     # Antiparallel directions (a bone onto its reverse, a back bent double) have no single
@@ -89,6 +96,8 @@ def _in_frame(q: np.ndarray, frame: np.ndarray) -> np.ndarray:
     return out
 
 
+_BONE_STARTS = np.array([1, 2, 1])
+"""Where the vectors of :func:`solve` start: the upper, middle and upper joint."""
 _UNDO_LAST = np.array([[1.0, 1, 1, 1], [1, 1, 1, 1], [1, -1, -1, -1]])
 """Conjugates the third of three stacked quaternions (quat.conj's sign pattern)."""
 
@@ -111,23 +120,29 @@ def solve(
         joints: indices ``(3,)`` or ``(S, 3)`` of the upper, middle and end joints.
         target: ``(B, [S,] 3)`` where the end joint should go.
     """
-    a, b, c = positions[..., 1, :], positions[..., 2, :], positions[..., 3, :]
-    u1, l1 = _unit(b - a)
-    u2, l2 = _unit(c - b)
-    d = np.minimum(np.maximum(_norm(target - a)[..., 0], np.abs(l1 - l2) + 1e-9), l1 + l2 - 1e-9)
+    a, b = positions[..., 1, :], positions[..., 2, :]
+    # The two bones and the upper joint to the target (b - a, c - b, target - a), their
+    # directions and lengths, in one difference and one norm (numpy's per-call set-up, not
+    # the arithmetic, is what a tick's few vectors cost).
+    ends = np.concatenate([positions[..., 2:, :], target[..., None, :]], axis=-2)
+    arms = ends - positions.take(_BONE_STARTS, axis=-2)  # (B, [S,] 3, 3)
+    units, lengths = unit(arms)
+    u1, u2, to_target = units[..., 0, :], units[..., 1, :], units[..., 2, :]
+    l1, l2 = lengths[..., 0], lengths[..., 1]
+    d = np.minimum(np.maximum(lengths[..., 2], np.abs(l1 - l2) + 1e-9), l1 + l2 - 1e-9)
     # 1. Bend the middle joint about the normal of its current bend plane (its hinge) until
     #    root and end are ``d`` apart (law of cosines on the bend angle u1 -> u2).
-    normal, bent = _unit(quat.cross(u1, u2))
+    normal, bent = unit(quat.cross(u1, u2))
     straight = bent < 1e-9  # a fully straight limb has no plane: bend about a horizontal axis
     if straight.any():
-        fallback, _ = _unit(quat.cross(u1, np.where(np.abs(u1[..., 2:]) < 0.9, _Z, _X)))
+        fallback, _ = unit(quat.cross(u1, np.where(np.abs(u1[..., 2:]) < 0.9, _Z, _X)))
         normal = np.where(straight[..., None], fallback, normal)
     bend_now = np.arctan2(bent, np.add.reduce(u1 * u2, axis=-1))
     cos_bend = np.minimum(np.maximum((d**2 - l1**2 - l2**2) / (2.0 * l1 * l2), -1.0), 1.0)
     turn_lower = quat.from_axis_angle(normal, np.arccos(cos_bend) - bend_now)
-    new_c = b + quat.rotate(turn_lower, c - b)
+    new_c = b + quat.rotate(turn_lower, arms[..., 1, :])
     # 2. Swing the whole limb at the root, by the smallest rotation, onto the target.
-    turn_upper = shortest_arc(new_c - a, target - a)
+    turn_upper = unit_arc(unit(new_c - a)[0], to_target)
     # The end joint keeps its global rotation: undo both turns in the old middle frame.
     both = quat.mul(turn_upper, turn_lower)
     # The three turns in the frames of the parent, upper and middle joints (the first three

@@ -232,19 +232,24 @@ class AnalyticIK:
         spine_rot = quat.mul(pelvis_rot, spine_bend)
         glob = np.concatenate([pelvis_rot[:, None], spine_rot[:, None]], axis=1)  # (B, 2, 4)
         parent = glob.take(self.upper_anchor, axis=1)  # (B, 4, 4) hips' and shoulders' parents
-        # One matrix conversion for the anchors, the rest limbs' middle joints pre-bent about
-        # their hinges (the bend planes) and the ends' goals.
-        middle_rot = quat.mul(parent, self.pre_bend)
+        # In one product: the rest limbs' middle joints pre-bent about their hinges (the bend
+        # planes) and the head's local rotation.
+        turned = quat.mul(
+            np.concatenate([parent, quat.conj(glob[:, self.head_anchor, None])], axis=1),
+            np.concatenate([self.pre_bend[None].repeat(b, axis=0), head_rot[:, None]], axis=1),
+        )
+        middle_rot = turned[:, :-1]
+        # One matrix conversion for the anchors, the middle joints and the ends' goals.
         mats = quat.unit_to_matrix(np.concatenate([glob, middle_rot, end_rot], axis=1))
         mats, middle_mat, end_mat = mats[:, :2], mats[:, 2:6], mats[:, 6:]  # (B, n, 3, 3)
         root_pos = pelvis_pos - (mats[:, 0] @ self.root_to_pelvis)
         spine_pos = root_pos + mats[:, 0] @ self.root_to_spine
         pos = np.concatenate([root_pos[:, None], spine_pos[:, None]], axis=1)
 
-        local = np.repeat(self.template[None], b, axis=0)
+        local = self.template[None].repeat(b, axis=0)
         local[:, 0] = pelvis_rot
         local[:, self.spine] = spine_bend
-        local[:, self.head] = quat.mul(quat.conj(glob[:, self.head_anchor]), head_rot)
+        local[:, self.head] = turned[:, -1]
 
         parent_mat = mats.take(self.upper_anchor, axis=1)
         upper_pos = pos.take(self.upper_anchor, axis=1)
@@ -288,7 +293,11 @@ class AnalyticIK:
         )
         turn = quat.from_axis_angle(axis, swivel)  # (B, 4, 4); a limb along its pole: ~0
         upper = quat.mul(turn, upper)
-        local[:, limb[:, 0]] = quat.mul(quat.conj(parent), upper)
-        middle = quat.mul(upper, local.take(limb[:, 1], axis=1))
-        local[:, limb[:, 2]] = quat.mul(quat.conj(middle), end_rot)
+        # The upper joints' local rotations and the middle joints' world ones in one product.
+        upper_middle = quat.mul(
+            np.concatenate([quat.conj(parent), upper], axis=1),
+            np.concatenate([upper, local.take(limb[:, 1], axis=1)], axis=1),
+        )
+        local[:, limb[:, 0]] = upper_middle[:, : len(LIMBS)]
+        local[:, limb[:, 2]] = quat.mul(quat.conj(upper_middle[:, len(LIMBS) :]), end_rot)
         return AnalyticPose(root_pos, local, upper_pos, target, end_mat)

@@ -1,0 +1,138 @@
+"""What one AvatarGo ``step()`` costs, and whether a change kept its output (issue 13).
+
+The inputs are ``avatarsim bench avatargo``'s (a sampled user waving for 4 s, six devices,
+realistic VR noise) and, where the real mocap is present, a Bandai dataset-2 right-hand wave
+(3 s, the scenario ``bandai2_wave_avatargo``'s clip) worn by a sampled user, the avatar rig
+as the avatar. Both with exact and with fixed offsets, the default (analytic) solver.
+
+    python tests/measurements/avatargo_step_cost.py outputs OUT.npz
+        run and step outputs (root, local rotations, palm distances, attached flags)
+    python tests/measurements/avatargo_step_cost.py compare BEFORE.npz AFTER.npz
+        largest difference of each output, and of step against run
+    python tests/measurements/avatargo_step_cost.py timing [REPEATS]
+        thread CPU time of each step on the bench input (exact offsets): per frame the best
+        of REPEATS passes (what the step costs), and every pass (what it costs on this
+        machine now), with the load average
+
+The script uses only the synthesiser's public API, so it runs on another checkout too:
+``PYTHONPATH=/path/to/main python <this file> outputs main.npz``.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+import avatar_models  # noqa: F401  (the headless GL backend, before anything imports mujoco)
+from avatar_models.formats import load_motion
+from avatar_models.generator import generate, sample_subject
+from avatar_models.rigs import load_rig
+from scripts.stages.devices import REALISTIC_NOISE
+from synthesis.avatargo import AvatarGo
+from synthesis.avatargo.study import sample_user, setup_for
+from synthesis.avatargo.walk_in import walk_in
+from synthesis.base import TrackingFrame
+
+MOCAP = Path(
+    os.environ.get(
+        "AVATARSIM_MOCAP", Path(__file__).resolve().parents[2].parent / "shared" / "mocap"
+    )
+)
+"""Real mocap, as the tests find it (``tests/conftest.py``)."""
+BANDAI = "bandai/dataset-2/data/dataset-2_wave-right-hand_normal_001.bvh"
+
+
+def bench_input():
+    """The bench's avatar skeleton, walk-in sample and stream."""
+    truth = generate("wave", sample_subject(np.random.default_rng(0)), 4.0)
+    user = sample_user(0, truth.skeleton)
+    setup = setup_for(user, REALISTIC_NOISE)
+    stream = setup.sample(truth, seed=user.seed)
+    return truth.skeleton, walk_in(setup, truth, user.seed, user.heading_rad), stream
+
+
+def bandai_input():
+    """The avatar rig, the walk-in of a sampled user wearing a Bandai dataset-2 wave (3 s),
+    and its stream; None without the real mocap."""
+    path = MOCAP / BANDAI
+    if not path.is_file():
+        return None
+    truth = load_motion(path).resample(90.0)
+    truth = truth[: int(3 * truth.fps)]
+    user = sample_user(1, truth.skeleton)
+    setup = setup_for(user, REALISTIC_NOISE)
+    stream = setup.sample(truth, seed=user.seed)
+    avatar = load_rig("avatar").skeleton
+    return avatar, walk_in(setup, truth, user.seed, user.heading_rad), stream
+
+
+def outputs() -> dict[str, np.ndarray]:
+    arrays = {}
+    for tag, given in {"bench": bench_input(), "bandai": bandai_input()}.items():
+        if given is None:
+            print(f"{tag}: no real mocap under {MOCAP}, skipped")
+            continue
+        avatar, sample, stream = given
+        for offsets in ("exact", "fixed"):
+            synth = AvatarGo(avatar, sample, offsets=offsets)
+            motion = synth.run(stream)
+            key = f"{tag}/{offsets}"
+            arrays[f"{key}/run_rot"] = motion.local_rot
+            arrays[f"{key}/run_root"] = motion.root_pos
+            arrays[f"{key}/run_palm"] = np.array(synth.palm_distance)
+            arrays[f"{key}/run_attached"] = np.array(synth.attached)
+            synth.reset()
+            steps = [
+                synth.step(TrackingFrame.from_stream(stream, i)) for i in range(stream.n_samples)
+            ]
+            arrays[f"{key}/step_rot"] = np.stack([p.local_rot for p in steps])
+            arrays[f"{key}/step_root"] = np.stack([p.root_pos for p in steps])
+            arrays[f"{key}/step_palm"] = np.array(synth.palm_distance)
+            arrays[f"{key}/step_attached"] = np.array(synth.attached)
+    return arrays
+
+
+def compare(before: Path, after: Path) -> None:
+    a, b = np.load(before), np.load(after)
+    for key in a.files:
+        diff = np.max(np.abs(b[key].astype(float) - a[key].astype(float)))
+        print(f"{key:28s} max |after - before| {diff:.3e}")
+    for key in (k for k in b.files if "/run_" in k and k.endswith(("rot", "root"))):
+        diff = np.max(np.abs(b[key] - b[key.replace("/run_", "/step_")]))
+        print(f"{key.replace('/run_', '/step-vs-run_'):28s} max |step - run| {diff:.3e}")
+
+
+def timing(repeats: int) -> None:
+    avatar, sample, stream = bench_input()
+    frames = [TrackingFrame.from_stream(stream, i) for i in range(stream.n_samples)]
+    synth = AvatarGo(avatar, sample)
+    cpu = np.empty((repeats, len(frames)))
+    for r in range(repeats):
+        synth.reset()
+        for i, frame in enumerate(frames):
+            start = time.thread_time_ns()
+            synth.step(frame)
+            cpu[r, i] = time.thread_time_ns() - start
+    best, every = cpu.min(axis=0) / 1e6, cpu / 1e6
+    print(
+        f"avatargo CPU ms per step, best of {repeats} per frame: "
+        f"p50 {np.percentile(best, 50):.3f} p99 {np.percentile(best, 99):.3f}; "
+        f"every pass: p50 {np.percentile(every, 50):.3f} p99 {np.percentile(every, 99):.3f}; "
+        f"load {os.getloadavg()[0]:.2f}"
+    )
+
+
+if __name__ == "__main__":
+    command = sys.argv[1] if len(sys.argv) > 1 else "timing"
+    if command == "outputs":
+        np.savez(sys.argv[2], **outputs())
+    elif command == "compare":
+        compare(Path(sys.argv[2]), Path(sys.argv[3]))
+    elif command == "timing":
+        timing(int(sys.argv[2]) if len(sys.argv) > 2 else 7)
+    else:
+        sys.exit(f"unknown command {command!r}: outputs OUT.npz | compare A.npz B.npz | timing [N]")
