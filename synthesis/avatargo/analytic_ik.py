@@ -194,6 +194,11 @@ class AnalyticIK:
         self.hinges /= np.linalg.norm(self.hinges, axis=-1, keepdims=True)
         self.pre_bend = quat.from_axis_angle(self.hinges, np.full(len(LIMBS), PRE_BEND_RAD))
         self.elbow_poles = ELBOW_POLES / np.linalg.norm(ELBOW_POLES, axis=-1, keepdims=True)
+        # The vectors turned by the limbs' parents and by the root's rotation, as columns:
+        # one matrix product each (a tick's hot path). (A third column, the elbows' poles,
+        # moved the last bit: BLAS takes another kernel.)
+        self._upper_columns = np.stack([self.upper_offsets, self.upper_bones], axis=-1)
+        self._root_columns = np.stack([self.root_to_pelvis, self.root_to_spine], axis=-1)
         l1 = np.linalg.norm(self.upper_bones, axis=-1)
         l2 = np.linalg.norm(self.lower_bones, axis=-1)
         knees_elbows = zip(limbs[:, 1], self.hinges, strict=True)
@@ -242,8 +247,9 @@ class AnalyticIK:
         # One matrix conversion for the anchors, the middle joints and the ends' goals.
         mats = quat.unit_to_matrix(np.concatenate([glob, middle_rot, end_rot], axis=1))
         mats, middle_mat, end_mat = mats[:, :2], mats[:, 2:6], mats[:, 6:]  # (B, n, 3, 3)
-        root_pos = pelvis_pos - (mats[:, 0] @ self.root_to_pelvis)
-        spine_pos = root_pos + mats[:, 0] @ self.root_to_spine
+        from_root = mats[:, 0] @ self._root_columns  # (B, 3, 2) to the pelvis, to the spine
+        root_pos = pelvis_pos - from_root[..., 0]
+        spine_pos = root_pos + from_root[..., 1]
         pos = np.concatenate([root_pos[:, None], spine_pos[:, None]], axis=1)
 
         local = self.template[None].repeat(b, axis=0)
@@ -253,8 +259,9 @@ class AnalyticIK:
 
         parent_mat = mats.take(self.upper_anchor, axis=1)
         upper_pos = pos.take(self.upper_anchor, axis=1)
-        upper_pos = upper_pos + (parent_mat @ self.upper_offsets[..., None])[..., 0]
-        middle_pos = upper_pos + (parent_mat @ self.upper_bones[..., None])[..., 0]
+        offsets = parent_mat @ self._upper_columns  # (B, 4, 3, 2) offsets, upper bones
+        upper_pos = upper_pos + offsets[..., 0]
+        middle_pos = upper_pos + offsets[..., 1]
         end_now = middle_pos + (middle_mat @ self.lower_bones[..., None])[..., 0]
         globs = np.concatenate(
             [m[:, :, None] for m in (parent_mat, parent_mat, middle_mat, middle_mat)], 2

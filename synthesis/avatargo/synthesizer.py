@@ -377,11 +377,12 @@ class AvatarGo(Synthesizer):
         """The analytic solver on the whole batch at once, or the QP solvers' goals for the
         batch, then one warm-started solve per frame; the fingers frame by frame."""
         index = self.device_index(frames)
-        ok = frames.usable().take(index, axis=1)  # x[:, index] without its set-up
         poses = np.concatenate(
             [frames.positions.take(index, axis=1), frames.quaternions.take(index, axis=1)],
             -1,
-        )
+        )  # (x.take: x[:, index] without its set-up)
+        # frames.usable() of the devices read, on their poses gathered already.
+        ok = np.isfinite(poses).all(-1) & frames.valid.take(index, axis=1).astype(bool)
         if ok.all():  # the common case: every device tracked, and so seen (a per-tick fast path)
             seen = np.ones(frames.size, bool)
         else:
@@ -400,12 +401,12 @@ class AvatarGo(Synthesizer):
             root_pos, local = self._solve_qp(pos, rot, seen)
         if self.finger_ik is not None:
             fingers = self.finger_ik
-            rotations = []
-            for _ in range(frames.size):
+            rotations = np.empty((frames.size, *fingers.rig.joints.shape, 4))  # (B, F, 3, 4)
+            for b in range(frames.size):
                 fingers.advance()
-                rotations.append(fingers.rotations())
+                rotations[b] = fingers.rotations()
             local = local.copy()
-            local[:, fingers.rig.joints] = np.stack(rotations)
+            local[:, fingers.rig.joints] = rotations
         return Poses(root_pos, local)
 
     def analytic_goals(self, positions: np.ndarray, quaternions: np.ndarray) -> AnalyticGoals:
@@ -439,10 +440,12 @@ class AvatarGo(Synthesizer):
         controllers = pos.take(HAND_DEVICES, axis=1)
         palm = palm_distance(solved.end_pos[:, LEGS:], wrist_mat, controllers, self.grip)
         reach = out_of_reach(solved.upper_pos[:, LEGS:], wrist_pos, self._arm_length)
+        if seen.all():
+            self.palm_distance.extend(palm)
+            self.attached.extend(reach)
+            return solved.root_pos, solved.local_rot
         self.palm_distance.extend(palm[seen])
         self.attached.extend(reach[seen])
-        if seen.all():
-            return solved.root_pos, solved.local_rot
         t_pose = np.tile(quat.IDENTITY, (self.body.skeleton.n_joints, 1))
         t_pose[0] = cal.roles.heading
         root_pos = np.where(seen[:, None], solved.root_pos, cal.root_pos)
