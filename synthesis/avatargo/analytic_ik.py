@@ -194,10 +194,19 @@ class AnalyticIK:
         self.hinges /= np.linalg.norm(self.hinges, axis=-1, keepdims=True)
         self.pre_bend = quat.from_axis_angle(self.hinges, np.full(len(LIMBS), PRE_BEND_RAD))
         self.elbow_poles = ELBOW_POLES / np.linalg.norm(ELBOW_POLES, axis=-1, keepdims=True)
-        # The vectors turned by the limbs' parents and by the root's rotation, as columns:
-        # one matrix product each (a tick's hot path). (A third column, the elbows' poles,
-        # moved the last bit: BLAS takes another kernel.)
-        self._upper_columns = np.stack([self.upper_offsets, self.upper_bones], axis=-1)
+        poles = np.concatenate([np.zeros((LEGS, 3)), self.elbow_poles])  # knees: none
+        self.rest_vectors = np.stack(
+            [self.upper_offsets, self.upper_bones, self.lower_bones, poles], axis=1
+        )
+        """``(4, 4, 3)`` per limb: the upper joint from its anchor, the upper and lower bones,
+        the elbow's pole (the knees': 0), each in the rest frame of :attr:`frame_index`'s."""
+        middle = 2 + np.arange(len(LIMBS))  # the middle joints' rows of solve's matrices
+        self.frame_index = np.stack(
+            [self.upper_anchor, self.upper_anchor, middle, self.upper_anchor], axis=1
+        )
+        """``(4, 4)`` rows of :meth:`solve`'s world matrices (root, spine joint, the four
+        middle joints, ...) that turn :attr:`rest_vectors`: the anchor's, the anchor's, the
+        middle joint's, the anchor's."""
         self._root_columns = np.stack([self.root_to_pelvis, self.root_to_spine], axis=-1)
         l1 = np.linalg.norm(self.upper_bones, axis=-1)
         l2 = np.linalg.norm(self.lower_bones, axis=-1)
@@ -246,7 +255,7 @@ class AnalyticIK:
         middle_rot = turned[:, :-1]
         # One matrix conversion for the anchors, the middle joints and the ends' goals.
         mats = quat.unit_to_matrix(np.concatenate([glob, middle_rot, end_rot], axis=1))
-        mats, middle_mat, end_mat = mats[:, :2], mats[:, 2:6], mats[:, 6:]  # (B, n, 3, 3)
+        end_mat = mats[:, 2 + len(LIMBS) :]  # (B, 4, 3, 3)
         from_root = mats[:, 0] @ self._root_columns  # (B, 3, 2) to the pelvis, to the spine
         root_pos = pelvis_pos - from_root[..., 0]
         spine_pos = root_pos + from_root[..., 1]
@@ -257,18 +266,14 @@ class AnalyticIK:
         local[:, self.spine] = spine_bend
         local[:, self.head] = turned[:, -1]
 
-        parent_mat = mats.take(self.upper_anchor, axis=1)
-        upper_pos = pos.take(self.upper_anchor, axis=1)
-        offsets = parent_mat @ self._upper_columns  # (B, 4, 3, 2) offsets, upper bones
-        upper_pos = upper_pos + offsets[..., 0]
-        middle_pos = upper_pos + offsets[..., 1]
-        end_now = middle_pos + (middle_mat @ self.lower_bones[..., None])[..., 0]
-        globs = np.concatenate(
-            [m[:, :, None] for m in (parent_mat, parent_mat, middle_mat, middle_mat)], 2
-        )  # end's unused
-        chain_pos = np.concatenate(
-            [p[:, :, None] for p in (upper_pos, upper_pos, middle_pos, end_now)], 2
-        )
+        # Each limb's rest vectors (:attr:`rest_vectors`) turned by their frames, in one
+        # product; the chain's positions are their running sum from the anchor (cumsum adds
+        # in the order a loop would). The first three frames are the two-bone solve's.
+        globs = mats.take(self.frame_index, axis=1)  # (B, 4, 4, 3, 3)
+        steps = (globs @ self.rest_vectors[..., None])[..., 0]  # (B, 4, 4, 3)
+        anchor = pos.take(self.upper_anchor, axis=1)[:, :, None]
+        chain_pos = np.concatenate([anchor, steps[:, :, :3]], axis=2).cumsum(axis=2)
+        upper_pos = chain_pos[:, :, 1]  # (B, 4, 3)
         # Goals nearer than the flexion limit or beyond the limb's length: the reachable
         # point on the way to the goal.
         # (np.linalg.norm's and np.clip's arithmetic without their Python wrappers, whose
@@ -287,14 +292,16 @@ class AnalyticIK:
         # with the wrist straight (the hand's goal rotation carrying the forearm), nudged
         # towards down and back for an arm straight in the hand's goal (that point then
         # lies on the line).
-        elbows = (parent_mat[:, LEGS:] @ self.elbow_poles[..., None])[..., 0]  # (B, 2, 3)
+        elbows = steps[:, LEGS:, 3]  # (B, 2, 3)
         straight = (end_mat[:, LEGS:] @ self.lower_bones[LEGS:, :, None])[..., 0]
         straight = target[:, LEGS:] - straight - upper_pos[:, LEGS:]
         pole = np.concatenate([end_mat[:, :LEGS, :, 0], straight + POLE_NUDGE_M * elbows], 1)
         axis = target - upper_pos
         axis /= np.sqrt(np.add.reduce(axis * axis, axis=-1, keepdims=True))
-        bent = bent - np.add.reduce(bent * axis, -1, keepdims=True) * axis  # across the line
-        pole = pole - np.add.reduce(pole * axis, -1, keepdims=True) * axis
+        both = np.concatenate([bent[:, :, None], pole[:, :, None]], axis=2)  # (B, 4, 2, 3)
+        along = axis[:, :, None]
+        both = both - np.add.reduce(both * along, -1, keepdims=True) * along  # across the line
+        bent, pole = both[:, :, 0], both[:, :, 1]
         swivel = np.arctan2(
             np.add.reduce(quat.cross(bent, pole) * axis, -1), np.add.reduce(bent * pole, -1)
         )
