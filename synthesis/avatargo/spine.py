@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from synthesis.two_bone import shortest_arc
+from synthesis.two_bone import shortest_arc, unit, unit_arc
 
 
 def bend_angle(w0: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -42,10 +42,11 @@ def spine_bend(w0: np.ndarray, w: np.ndarray) -> np.ndarray:
 
 
 def spine_bend_in_root(w0_in_root: np.ndarray, w: np.ndarray, root_mat: np.ndarray) -> np.ndarray:
-    """``(B, 4)`` eq. 4's bend in the root joint's frame: ``w0_in_root (3,)``, eq. 1's ``w0``
-    seen from the root's walk-in rotation (``R0(root)^-1 w0``), turned onto ``w (B, 3)`` seen
-    from the root's rotations, as matrices ``root_mat (B, 3, 3)`` (module docstring; the
-    caller has them already, a tick's hot path)."""
+    """``(B, 4)`` eq. 4's bend in the root joint's frame: ``w0_in_root (3,)``, the direction
+    of eq. 1's ``w0`` seen from the root's walk-in rotation (``R0(root)^-1 w0``, normalised
+    by :func:`~synthesis.two_bone.unit`: the caller keeps it from tick to tick), turned onto
+    ``w (B, 3)`` seen from the root's rotations, as matrices ``root_mat (B, 3, 3)`` (module
+    docstring; the caller has them already, a tick's hot path)."""
     # R^T w by a matrix product: fewer numpy calls than quat.rotate on a tick's vectors.
     w_in_root = (np.asarray(w)[..., None, :] @ root_mat)[..., 0, :]
-    return spine_bend(w0_in_root, w_in_root)
+    return unit_arc(w0_in_root, unit(w_in_root)[0])

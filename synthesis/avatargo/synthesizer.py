@@ -89,6 +89,7 @@ from synthesis.base import (
     Synthesizer,
     TrackingFrame,
 )
+from synthesis.two_bone import unit
 
 SITES = ("head", "l_ankle", "r_ankle", "pelvis", "neck", "l_wrist", "r_wrist")
 """The humanoid's body17 sites the IK steers, in goal order: the tracked joints first, in
@@ -249,7 +250,7 @@ class AvatarGo(Synthesizer):
                 np.concatenate([cal.tracked.position, cal.hands.position]),
                 np.concatenate([cal.tracked.rotation, cal.hands.rotation]),
             )
-            self._w0_in_root = self.analytic.spine_to_head  # eq. 1 in the root's frame
+            self._w0_in_root, _ = unit(self.analytic.spine_to_head)  # eq. 1, the root's frame
         else:
             self._build_qp(QP_SOLVERS[solver])
 
@@ -384,7 +385,7 @@ class AvatarGo(Synthesizer):
         # frames.usable() of the devices read, on their poses gathered already.
         ok = np.isfinite(poses).all(-1) & frames.valid.take(index, axis=1).astype(bool)
         if ok.all():  # the common case: every device tracked, and so seen (a per-tick fast path)
-            seen = np.ones(frames.size, bool)
+            seen = ok[:, 0]  # all True (a view: np.ones' Python wrapper costs more)
         else:
             last = np.concatenate([self._last_pos, self._last_rot], -1)
             poses = _first_usable(poses, ok, last)  # (B, 6, 7) positions and rotations

@@ -12,6 +12,7 @@ from avatar_models.generator import generate
 from avatar_models.generator.subject import Subject
 from synthesis.avatargo.analytic_ik import LIMBS, AnalyticGoals, AnalyticIK
 from synthesis.avatargo.spine import bend_angle, spine_bend_in_root
+from synthesis.two_bone import unit
 
 HEADING = quat.from_axis_angle(np.array([0.0, 0.0, 1.0]), np.array(0.6))
 
@@ -109,9 +110,8 @@ def test_spine_inclines_by_eq4s_angle(body):
     w0 = quat.rotate(HEADING, head - pelvis)
     lateral = quat.rotate(HEADING, np.array([0.0, 1.0, 0.0]))
     w = quat.rotate(quat.from_axis_angle(lateral, np.array(np.radians(25.0))), w0)
-    bend = spine_bend_in_root(
-        quat.rotate(quat.conj(HEADING), w0), w[None], quat.unit_to_matrix(HEADING[None])
-    )
+    w0_in_root, _ = unit(quat.rotate(quat.conj(HEADING), w0))
+    bend = spine_bend_in_root(w0_in_root, w[None], quat.unit_to_matrix(HEADING[None]))
     assert np.degrees(bend_angle(w0, w[None]))[0] == pytest.approx(25.0)
     ends = np.zeros((1, 4, 3))  # unreachable: only the spine matters here
     pos, _ = solved(ik, body, standing_goals(body, ends, bend))
