@@ -111,6 +111,7 @@ class AnalyticPose:
         upper_pos: ``(B, 4, 3)`` hips and shoulders (:data:`LIMBS` order).
         end_pos: ``(B, 4, 3)`` where ankles and wrists ended (their goals where reachable).
         end_mat: ``(B, 4, 3, 3)`` their world rotations (the goals'), as matrices.
+        goal_dist: ``(B, 4)`` metres from the hips and shoulders to the ends' goals.
     """
 
     root_pos: np.ndarray
@@ -118,6 +119,7 @@ class AnalyticPose:
     upper_pos: np.ndarray
     end_pos: np.ndarray
     end_mat: np.ndarray
+    goal_dist: np.ndarray
 
 
 def path_between(parents, ancestor: int, joint: int) -> list[int]:
@@ -246,14 +248,9 @@ class AnalyticIK:
         spine_rot = quat.mul(pelvis_rot, spine_bend)
         glob = np.concatenate([pelvis_rot[:, None], spine_rot[:, None]], axis=1)  # (B, 2, 4)
         parent = glob.take(self.upper_anchor, axis=1)  # (B, 4, 4) hips' and shoulders' parents
-        # In one product: the rest limbs' middle joints pre-bent about their hinges (the bend
-        # planes) and the head's local rotation.
-        turned = quat.mul(
-            np.concatenate([parent, quat.conj(glob[:, self.head_anchor, None])], axis=1),
-            np.concatenate([self.pre_bend[None].repeat(b, axis=0), head_rot[:, None]], axis=1),
-        )
-        middle_rot = turned[:, :-1]
-        # One matrix conversion for the anchors, the middle joints and the ends' goals.
+        # One matrix conversion for the anchors, the rest limbs' middle joints pre-bent about
+        # their hinges (the bend planes) and the ends' goals.
+        middle_rot = quat.mul(parent, self.pre_bend)
         mats = quat.unit_to_matrix(np.concatenate([glob, middle_rot, end_rot], axis=1))
         end_mat = mats[:, 2 + len(LIMBS) :]  # (B, 4, 3, 3)
         from_root = mats[:, 0] @ self._root_columns  # (B, 3, 2) to the pelvis, to the spine
@@ -264,7 +261,7 @@ class AnalyticIK:
         local = self.template[None].repeat(b, axis=0)
         local[:, 0] = pelvis_rot
         local[:, self.spine] = spine_bend
-        local[:, self.head] = turned[:, -1]
+        local[:, self.head] = quat.mul(quat.conj(glob[:, self.head_anchor]), head_rot)
 
         # Each limb's rest vectors (:attr:`rest_vectors`) turned by their frames, in one
         # product; the chain's positions are their running sum from the anchor (cumsum adds
@@ -314,4 +311,4 @@ class AnalyticIK:
         )
         local[:, limb[:, 0]] = upper_middle[:, : len(LIMBS)]
         local[:, limb[:, 2]] = quat.mul(quat.conj(upper_middle[:, len(LIMBS) :]), end_rot)
-        return AnalyticPose(root_pos, local, upper_pos, target, end_mat)
+        return AnalyticPose(root_pos, local, upper_pos, target, end_mat, dist[..., 0])

@@ -129,4 +129,10 @@ def out_of_reach(shoulders: np.ndarray, wrist_goals: np.ndarray, arm: np.ndarray
     ``arm (2,)`` (plus :data:`REACH_SLACK_M`) from its shoulder ``(B, 2, 3)``: there the
     virtual controller is attached to the hand (§3.4)."""
     reach = wrist_goals - shoulders
-    return np.sqrt(np.add.reduce(reach * reach, axis=-1)) > arm + REACH_SLACK_M
+    return beyond_reach(np.sqrt(np.add.reduce(reach * reach, axis=-1)), arm)
+
+
+def beyond_reach(distance: np.ndarray, arm: np.ndarray) -> np.ndarray:
+    """:func:`out_of_reach` of wrist goals ``distance (B, 2)`` metres from their shoulders
+    (for a solver that has the distances already)."""
+    return distance > arm + REACH_SLACK_M

@@ -72,6 +72,7 @@ from synthesis.avatargo.calibration import Roles, classes_of, identify_roles
 from synthesis.avatargo.fingers import FingerIK
 from synthesis.avatargo.hands import (
     Grip,
+    beyond_reach,
     grip_of,
     has_fingers,
     out_of_reach,
@@ -437,10 +438,10 @@ class AvatarGo(Synthesizer):
         cal = self.calibration
         goals = self.analytic_goals(pos, rot)
         solved = self.analytic.solve(*goals)
-        wrist_pos, wrist_mat = goals.end_pos[:, LEGS:], solved.end_mat[:, LEGS:]
         controllers = pos.take(HAND_DEVICES, axis=1)
-        palm = palm_distance(solved.end_pos[:, LEGS:], wrist_mat, controllers, self.grip)
-        reach = out_of_reach(solved.upper_pos[:, LEGS:], wrist_pos, self._arm_length)
+        wrists = solved.end_pos[:, LEGS:], solved.end_mat[:, LEGS:]
+        palm = palm_distance(*wrists, controllers, self.grip)
+        reach = beyond_reach(solved.goal_dist[:, LEGS:], self._arm_length)
         if seen.all():
             self.palm_distance.extend(palm)
             self.attached.extend(reach)
