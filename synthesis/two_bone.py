@@ -83,8 +83,10 @@ def unit_arc(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     cos = np.add.reduce(a * b, axis=-1, keepdims=True)
     q = np.concatenate([1.0 + cos, quat.cross(a, b)], axis=-1)
     # Antiparallel directions (a bone onto its reverse, a back bent double) have no single
-    # shortest arc: identity there, as for parallel ones.
-    return np.where(q[..., :1] > _EPS, q, quat.IDENTITY) / np.maximum(_norm(q), _EPS)
+    # shortest arc: identity there, as for parallel ones (normalised after the choice: the
+    # arc's own norm there is ~0, and dividing the identity by it gave 1e12).
+    q = np.where(q[..., :1] > _EPS, q, quat.IDENTITY)
+    return q / np.maximum(_norm(q), _EPS)
 
 
 def _in_frame(q: np.ndarray, frame: np.ndarray) -> np.ndarray:

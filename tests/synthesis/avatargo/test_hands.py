@@ -9,7 +9,7 @@ from avatar_models.generator import generate
 from avatar_models.generator.subject import Subject
 from avatar_models.rigs import load_rig
 from render_cams.vr import nominal_attachment
-from synthesis.avatargo.hands import CONTROLLER_RADIUS_M, grip_of, out_of_reach
+from synthesis.avatargo.hands import CONTROLLER_RADIUS_M, beyond_reach, grip_of, out_of_reach
 from synthesis.avatargo.study import SimulatedUser, study_run
 from synthesis.avatargo.walk_in import t_pose
 
@@ -28,6 +28,8 @@ def test_out_of_reach():
     shoulders = np.zeros((1, 2, 3))
     goals = np.array([[[0.5, 0.0, 0.0], [0.0, 0.7, 0.0]]])
     assert out_of_reach(shoulders, goals, np.array([0.6, 0.6])).tolist() == [[False, True]]
+    # The same from the distances (0.5 m and 0.7 m from the shoulders).
+    assert beyond_reach(np.array([[0.5, 0.7]]), np.array([0.6, 0.6])).tolist() == [[False, True]]
 
 
 def test_short_arms_attach_the_controller():
