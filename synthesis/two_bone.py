@@ -42,8 +42,9 @@ def chain_fk(
         chain: ``(L,)`` or ``(S, L)`` joint indices from the root, each the parent of the next.
     """
     chain = np.asarray(chain)
-    mats = quat.unit_to_matrix(rotations[:, chain])[..., None, :, :]  # (B, [S,] L, 1, 3, 3)
-    glob = mats[..., 0, :, :, :]
+    # (x.take(i, axis): x[:, i] without advanced indexing's set-up, a step's hot path.)
+    mats = quat.unit_to_matrix(rotations.take(chain, axis=1))[..., None, :, :]
+    glob = mats[..., 0, :, :, :]  # (B, [S,] 1, 3, 3)
     globs = [glob]
     for link in range(1, chain.shape[-1]):
         glob = glob @ mats[..., link, :, :, :]
@@ -51,7 +52,7 @@ def chain_fk(
     globs = np.concatenate(globs, axis=-3)  # (B, [S,] L, 3, 3)
     # Each bone's offset in world axes, in one product for the whole chain; the positions
     # are then the running sum from the root (cumsum adds in the order a loop would).
-    steps = offsets[chain[..., 1:]][..., None]  # (S|, L-1, 3, 1)
+    steps = offsets.take(chain[..., 1:], axis=0)[..., None]  # (S|, L-1, 3, 1)
     scale = np.asarray(scale, float).reshape((-1,) + (1,) * (chain.ndim + 1))
     positions = np.empty(globs.shape[:-1])  # (B, [S,] L, 3)
     positions[..., 0, :] = np.asarray(root, float).reshape((-1,) + (1,) * (chain.ndim - 1) + (3,))
