@@ -8,7 +8,7 @@ as the avatar. Both with exact and with fixed offsets, the default (analytic) so
     python tests/measurements/avatargo_step_cost.py outputs OUT.npz
         run and step outputs (root, local rotations, palm distances, attached flags)
     python tests/measurements/avatargo_step_cost.py compare BEFORE.npz AFTER.npz
-        largest difference of each output, and of step against run
+        largest difference of each output, and of step against run (attached flags as 0/1)
     python tests/measurements/avatargo_step_cost.py timing [REPEATS]
         thread CPU time of each step on the bench input (exact offsets): per frame the best
         of REPEATS passes (what the step costs), and every pass (what it costs on this
@@ -21,8 +21,6 @@ The script uses only the synthesiser's public API, so it runs on another checkou
 from __future__ import annotations
 
 import os
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -36,6 +34,7 @@ from synthesis.avatargo import AvatarGo
 from synthesis.avatargo.study import sample_user, setup_for
 from synthesis.avatargo.walk_in import walk_in
 from synthesis.base import TrackingFrame
+from tests.measurements.coolmoves_step_cost import main, print_step_timing
 
 MOCAP = Path(
     os.environ.get(
@@ -84,7 +83,7 @@ def outputs() -> dict[str, np.ndarray]:
             arrays[f"{key}/run_rot"] = motion.local_rot
             arrays[f"{key}/run_root"] = motion.root_pos
             arrays[f"{key}/run_palm"] = np.array(synth.palm_distance)
-            arrays[f"{key}/run_attached"] = np.array(synth.attached)
+            arrays[f"{key}/run_attached"] = np.array(synth.attached, float)
             synth.reset()
             steps = [
                 synth.step(TrackingFrame.from_stream(stream, i)) for i in range(stream.n_samples)
@@ -92,47 +91,14 @@ def outputs() -> dict[str, np.ndarray]:
             arrays[f"{key}/step_rot"] = np.stack([p.local_rot for p in steps])
             arrays[f"{key}/step_root"] = np.stack([p.root_pos for p in steps])
             arrays[f"{key}/step_palm"] = np.array(synth.palm_distance)
-            arrays[f"{key}/step_attached"] = np.array(synth.attached)
+            arrays[f"{key}/step_attached"] = np.array(synth.attached, float)
     return arrays
-
-
-def compare(before: Path, after: Path) -> None:
-    a, b = np.load(before), np.load(after)
-    for key in a.files:
-        diff = np.max(np.abs(b[key].astype(float) - a[key].astype(float)))
-        print(f"{key:28s} max |after - before| {diff:.3e}")
-    for key in (k for k in b.files if "/run_" in k and k.endswith(("rot", "root"))):
-        diff = np.max(np.abs(b[key] - b[key.replace("/run_", "/step_")]))
-        print(f"{key.replace('/run_', '/step-vs-run_'):28s} max |step - run| {diff:.3e}")
 
 
 def timing(repeats: int) -> None:
     avatar, sample, stream = bench_input()
-    frames = [TrackingFrame.from_stream(stream, i) for i in range(stream.n_samples)]
-    synth = AvatarGo(avatar, sample)
-    cpu = np.empty((repeats, len(frames)))
-    for r in range(repeats):
-        synth.reset()
-        for i, frame in enumerate(frames):
-            start = time.thread_time_ns()
-            synth.step(frame)
-            cpu[r, i] = time.thread_time_ns() - start
-    best, every = cpu.min(axis=0) / 1e6, cpu / 1e6
-    print(
-        f"avatargo CPU ms per step, best of {repeats} per frame: "
-        f"p50 {np.percentile(best, 50):.3f} p99 {np.percentile(best, 99):.3f}; "
-        f"every pass: p50 {np.percentile(every, 50):.3f} p99 {np.percentile(every, 99):.3f}; "
-        f"load {os.getloadavg()[0]:.2f}"
-    )
+    print_step_timing("avatargo", AvatarGo(avatar, sample), stream, repeats)
 
 
 if __name__ == "__main__":
-    command = sys.argv[1] if len(sys.argv) > 1 else "timing"
-    if command == "outputs":
-        np.savez(sys.argv[2], **outputs())
-    elif command == "compare":
-        compare(Path(sys.argv[2]), Path(sys.argv[3]))
-    elif command == "timing":
-        timing(int(sys.argv[2]) if len(sys.argv) > 2 else 7)
-    else:
-        sys.exit(f"unknown command {command!r}: outputs OUT.npz | compare A.npz B.npz | timing [N]")
+    main(outputs, timing)

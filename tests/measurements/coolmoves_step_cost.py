@@ -120,28 +120,36 @@ def compare(before: Path, after: Path) -> None:
         print(f"{key.replace('/run_', '/step-vs-run_'):36s} max |step - run| {diff:.3e}")
 
 
+def print_step_timing(label: str, synth, stream, repeats: int) -> None:
+    """Thread CPU time of each ``synth.step`` over ``stream``, ``repeats`` passes: per frame
+    the best pass, and every pass, as p50 / p99 with the load average."""
+    frames = [TrackingFrame.from_stream(stream, i) for i in range(stream.n_samples)]
+    cpu = np.empty((repeats, len(frames)))
+    for r in range(repeats):
+        synth.reset()
+        for i, frame in enumerate(frames):
+            start = time.thread_time_ns()
+            synth.step(frame)
+            cpu[r, i] = time.thread_time_ns() - start
+    best, every = cpu.min(axis=0) / 1e6, cpu / 1e6
+    print(
+        f"{label:18s} CPU ms per step, best of {repeats} per frame: "
+        f"p50 {np.percentile(best, 50):.3f} p99 {np.percentile(best, 99):.3f}; "
+        f"every pass: p50 {np.percentile(every, 50):.3f} p99 {np.percentile(every, 99):.3f}; "
+        f"load {os.getloadavg()[0]:.2f}"
+    )
+
+
 def timing(repeats: int) -> None:
     database, height, stream = bench_input()
-    frames = [TrackingFrame.from_stream(stream, i) for i in range(stream.n_samples)]
     for method in METHODS:
         synth = build(method, MethodInputs(lambda: database, height, database.skeleton))
-        cpu = np.empty((repeats, len(frames)))
-        for r in range(repeats):
-            synth.reset()
-            for i, frame in enumerate(frames):
-                start = time.thread_time_ns()
-                synth.step(frame)
-                cpu[r, i] = time.thread_time_ns() - start
-        best, every = cpu.min(axis=0) / 1e6, cpu / 1e6
-        print(
-            f"{method:18s} CPU ms per step, best of {repeats} per frame: "
-            f"p50 {np.percentile(best, 50):.3f} p99 {np.percentile(best, 99):.3f}; "
-            f"every pass: p50 {np.percentile(every, 50):.3f} p99 {np.percentile(every, 99):.3f}; "
-            f"load {os.getloadavg()[0]:.2f}"
-        )
+        print_step_timing(method, synth, stream, repeats)
 
 
-if __name__ == "__main__":
+def main(outputs, timing) -> None:
+    """The command line of this script and of its siblings (module docstring), on their own
+    ``outputs() -> dict`` and ``timing(repeats)``."""
     command = sys.argv[1] if len(sys.argv) > 1 else "timing"
     if command == "outputs":
         np.savez(sys.argv[2], **outputs())
@@ -151,3 +159,7 @@ if __name__ == "__main__":
         timing(int(sys.argv[2]) if len(sys.argv) > 2 else 7)
     else:
         sys.exit(f"unknown command {command!r}: outputs OUT.npz | compare A.npz B.npz | timing [N]")
+
+
+if __name__ == "__main__":
+    main(outputs, timing)
