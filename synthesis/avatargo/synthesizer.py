@@ -27,12 +27,15 @@ Each tick (§3.4), by the per-tick IK ``solver`` (:data:`SOLVERS`):
   spine_bend_in_root`), the head turned as the headset, and closed-form two-bone limbs
   (:mod:`synthesis.two_bone`) onto the ankles' goals (eqs. 2-3) and the wrists' under the
   controllers, the ankles and wrists at their goal rotations. Vectorised over a batch's
-  frames. ``avatarsim bench avatargo`` on the shared 2-core machine (load average 3.9-4.1,
-  three runs): CPU time per tick p50 0.74-1.26 ms, p99 1.23-1.89 ms, against mink's
-  1.9-2.2 / 3.0-4.0 ms (the 1 ms p99 aim is not shown there; the tail is the machine's,
-  see :mod:`scripts.benchmarks.avatargo`). Feet and root on their goals: built-in study (30
-  users, realistic noise) 0.67 / 0.62 cm mean, against mink's 1.4-1.7 / 2.2 cm; the head
-  by forward kinematics 0.63 cm (mink 0.68).
+  frames. Per tick on the shared 2-core machine (load average 3.6-4.8), CPU time:
+  ``avatarsim bench avatargo`` (three runs, each after one of the previous version) p50
+  0.85-1.01 ms (before 1.29-1.41), p99 1.48-1.86 ms (before 1.85-2.09), but mink's, whose
+  tick barely changed, moved as much (p50 1.85-2.48 against 2.85-3.19): the machine's
+  drift; per frame the best of 5 passes (``tests/measurements/avatargo_step_cost.py timing
+  5``, four alternations) p50 0.63-0.66 ms against 0.70-1.09. The 1 ms p99 aim is not
+  shown there (the tail is the machine's, see :mod:`scripts.benchmarks.avatargo`). Feet
+  and root on their goals: built-in study (30 users, realistic noise) 0.67 / 0.62 cm mean,
+  against mink's 1.4-1.7 / 2.2 cm; the head by forward kinematics 0.63 cm (mink 0.68).
 - ``"mink"`` or ``"least-squares"`` (:data:`QP_SOLVERS`): full-body IK on the avatar's
   humanoid standing in for Unity's IK (:class:`~avatar_models.body.ik.HumanoidIK`,
   warm-started, a few iterations a tick) on goals for the root (pelvis), ankles and head
