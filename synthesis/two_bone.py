@@ -119,7 +119,7 @@ def solve(
         rotations: ``(B, J, 4)`` local rotations.
         globs, positions: ``(B, [S,] 4, 3, 3)`` and ``(B, [S,] 4, 3)`` global rotations and
             positions of the upper joint's parent, the upper, middle and end joints (from
-            :func:`chain_fk`).
+            :func:`chain_fk`; the parent's position and the end's rotation are not read).
         joints: indices ``(3,)`` or ``(S, 3)`` of the upper, middle and end joints.
         target: ``(B, [S,] 3)`` where the end joint should go.
     """

@@ -265,7 +265,8 @@ class AnalyticIK:
 
         # Each limb's rest vectors (:attr:`rest_vectors`) turned by their frames, in one
         # product; the chain's positions are their running sum from the anchor (cumsum adds
-        # in the order a loop would). The first three frames are the two-bone solve's.
+        # in the order a loop would). The first three frames are the two-bone solve's (it
+        # reads neither the fourth nor the first position, the anchor's).
         globs = mats.take(self.frame_index, axis=1)  # (B, 4, 4, 3, 3)
         steps = (globs @ self.rest_vectors[..., None])[..., 0]  # (B, 4, 4, 3)
         anchor = pos.take(self.upper_anchor, axis=1)[:, :, None]
