@@ -119,11 +119,12 @@ class BothHandsKNN:
     96 gained nothing reliable and reorder equidistant matches; a brute-force product with
     ``argpartition`` took 440 us; the previous step's k-th distance as
     ``distance_upper_bound`` gained nothing (a window's neighbours are found fast, proving
-    them is the cost). In a step the query costs two to three times as much as alone: the
-    rest of the step evicts the tree from the cache. With the data in leaf order
-    (:func:`leaf_ordered_tree`), the bench's 713 step queries with 4 MB read between queries
-    (per query best of 7, four rounds at load 2.1-2.4) took 77-81 / 152-211 us at p50 / p99,
-    against 86-139 / 189-274 us with scipy's layout.
+    them is the cost). In a step the query costs about twice as much as alone: the rest of
+    the step evicts the tree from the cache. With the data in leaf order
+    (:func:`leaf_ordered_tree`), ``cKDTree.query`` inside the bench's steps (per frame best
+    of 9, passes alternating with scipy's layout, three rounds at load 3.8-4.1) took
+    112-120 / 226-338 us at p50 / p99, against 123-152 / 288-386 us; alone, with 4 MB read
+    between queries (four rounds at load 2.1-2.4), 77-81 / 152-211 against 86-139 / 189-274.
 
     Args:
         vectors: per side (left, right) ``(N_s, F)`` search vectors of the database windows.
