@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from avatar_models import quat
@@ -20,7 +21,7 @@ from synthesis.coolmoves.features import (
     speed_windows,
     window_stride,
 )
-from synthesis.coolmoves.knn import K_NEIGHBOURS, BothHandsKNN, KNNMatcher
+from synthesis.coolmoves.knn import K_NEIGHBOURS, BothHandsKNN, KNNMatcher, leaf_ordered_tree
 from synthesis.coolmoves.limits import JointLimits
 from synthesis.coolmoves.smoothing import ewma, ewma_step
 from tests.synthesis.conftest import yaw_matrix
@@ -135,6 +136,23 @@ def test_knn_threshold_drops_far_matches_but_never_all(small_db):
     dist, idx, w = KNNMatcher(small_db.search[0], k=5, max_distance=1e-6).query(far)
     assert np.all(np.isfinite(dist)) and np.all(idx >= 0)
     assert w.sum() == pytest.approx(1.0) and np.all(np.diff(dist[0]) >= 0)
+
+
+def test_leaf_ordered_tree_answers_as_scipys_tree():
+    """The same neighbours, distances and order as a plain ``cKDTree``, ties included
+    (duplicated points, as held poses give), with the data stored in another order."""
+    rng = np.random.default_rng(3)
+    points = rng.normal(size=(3000, 6))
+    points[1000:1400] = points[:400]  # exact duplicates: equidistant from every query
+    points[2000:2100] = 0.0
+    queries = np.concatenate([rng.normal(size=(200, 6)), points[:50], np.zeros((5, 6))])
+    tree, order = leaf_ordered_tree(points)
+    assert not np.array_equal(order, np.arange(len(points)))
+    np.testing.assert_array_equal(tree.data, points[order])
+    want = cKDTree(points, balanced_tree=False).query(queries, k=8)
+    got_dist, got_idx = tree.query(queries, k=8)
+    np.testing.assert_array_equal(got_dist, want[0])
+    np.testing.assert_array_equal(order[got_idx], want[1])
 
 
 def test_knn_k_of_one(small_db):
