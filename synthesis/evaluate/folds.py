@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from synthesis.coolmoves import Database, build_database
+from synthesis.coolmoves import Database, build_database, correlation
 from synthesis.evaluate.trials import EvaluationError, Trial
 
 PROTOCOLS = ("cross-subject", "cross-trial")
@@ -67,9 +67,14 @@ def folds(trials: Sequence[Trial], protocol: str) -> tuple[list[Fold], dict[str,
     return out, skipped
 
 
-def database_for(train: Sequence[Trial], headings: int = 1) -> Database:
+def database_for(
+    train: Sequence[Trial],
+    headings: int = 1,
+    correlation_threshold: float = correlation.CORRELATION_THRESHOLD,
+) -> Database:
     """The fold's database; ``headings > 1`` also holds every training motion turned to
-    ``headings`` equally spaced yaws about Z.
+    ``headings`` equally spaced yaws about Z; ``correlation_threshold`` is the hand-foot
+    filter's (§3.1.2; ``-inf`` keeps every trial, a diagnostic).
 
     Beyond the paper: its features are head-relative but not turned with the head (§3.1.2),
     so a user facing away from every performer finds no window within the KD-tree threshold
@@ -77,4 +82,5 @@ def database_for(train: Sequence[Trial], headings: int = 1) -> Database:
     give the search a match within ``180 / headings`` degrees, which the alignment refines.
     """
     yaws = 2.0 * np.pi * np.arange(headings) / headings
-    return build_database([t.motion.rotated_about_z(float(a)) for t in train for a in yaws])
+    motions = [t.motion.rotated_about_z(float(a)) for t in train for a in yaws]
+    return build_database(motions, correlation_threshold=correlation_threshold)

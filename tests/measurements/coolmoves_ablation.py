@@ -63,6 +63,7 @@ from synthesis.evaluate import database_for, folds, library_trials
 from synthesis.evaluate.validation import choose_max_distance
 from synthesis.methods import METHODS
 from synthesis.scoring import GROUPS, WARM_UP, score_run
+from tests.measurements import coolmoves_floors as floors
 from tests.measurements import coolmoves_reference as reference
 
 HANDS = body17.group_indices(body17.HANDS)
@@ -84,23 +85,26 @@ def reference_score(database, truth, stream, **kwargs) -> tuple[dict, float]:
 
 def single_pose_floor(database, truth) -> tuple[dict, float]:
     """Error (cm) of the database pose nearest to the truth in head-relative body17 joints,
-    per frame (no alignment, the truth known): what no pick of one database pose can beat."""
-    from scipy.spatial import cKDTree
-
-    from synthesis.coolmoves.database import driver_positions
-
-    joints = reference.head_relative_joints(database)
-    motion = motion_at_rate(truth, 90.0)
-    head, _ = driver_positions(motion, database.drivers)
-    relative = body17_positions(motion) - head[:, None]
-    _, nearest = cKDTree(joints.reshape(len(joints), -1)).query(relative.reshape(len(relative), -1))
-    err = 100.0 * np.linalg.norm(joints[nearest] - relative, axis=-1)[WARM_UP:].mean(axis=0)
+    per frame (no alignment, the truth known): what no pick of one database pose can beat
+    (:mod:`tests.measurements.coolmoves_floors` has the other floors)."""
+    err = floors.floor(floors.database_joints(database), floors.head_relative(truth))
     errs = {g: float(err[body17.group_indices(names)].mean()) for g, names in GROUPS.items()}
     return errs, float("nan")
 
 
+DATABASES = {
+    "paper": database_for,
+    "no filter": lambda train: database_for(train, correlation_threshold=-np.inf),
+    "2 headings": lambda train: database_for(train, headings=2),
+}
+"""The fold's database for a variant: the paper's, one keeping every training trial (the
+hand-foot filter off, a diagnostic), one also holding every trial turned by 180 degrees
+(beyond the paper: ``avatarsim eval --db-headings 2``)."""
+
+
 def variants(options):
-    """name -> (database, height, truth, stream, synth) -> (errors, hand r)."""
+    """name -> (database, run): the :data:`DATABASES` key and
+    ``run(database, height, truth, stream) -> (errors, hand r)``."""
 
     def coolmoves(**switches):
         def run(db, height, truth, stream):
@@ -111,18 +115,29 @@ def variants(options):
         return run
 
     return {
-        "paper": coolmoves(),
-        "no-threshold": coolmoves(max_distance=1e9),
-        "no-limits": coolmoves(clamp=False),
-        "no-smoothing": coolmoves(smooth=False),
-        "no-scaling": lambda db, h, truth, stream: coolmoves()(
-            db, standing_height(db.skeleton), truth, stream
+        "paper": ("paper", coolmoves()),
+        "no-threshold": ("paper", coolmoves(max_distance=1e9)),
+        "no-limits": ("paper", coolmoves(clamp=False)),
+        "no-smoothing": ("paper", coolmoves(smooth=False)),
+        "no-alignment": ("paper", coolmoves(align=False)),
+        "own-hand alignment": ("paper", coolmoves(align_own_hand=True)),
+        "no-scaling": (
+            "paper",
+            lambda db, h, truth, stream: coolmoves()(
+                db, standing_height(db.skeleton), truth, stream
+            ),
         ),
-        "reference w=0.5": lambda db, h, truth, stream: reference_score(db, truth, stream),
-        "reference w=1": lambda db, h, truth, stream: reference_score(
-            db, truth, stream, ewma_weight=1.0
+        "no-filter": ("no filter", coolmoves()),
+        "2 headings": ("2 headings", coolmoves()),
+        "reference w=0.5": (
+            "paper",
+            lambda db, h, truth, stream: reference_score(db, truth, stream),
         ),
-        "single-pose floor": lambda db, h, truth, stream: single_pose_floor(db, truth),
+        "reference w=1": (
+            "paper",
+            lambda db, h, truth, stream: reference_score(db, truth, stream, ewma_weight=1.0),
+        ),
+        "single-pose floor": ("paper", lambda db, h, truth, stream: single_pose_floor(db, truth)),
     }
 
 
@@ -134,12 +149,12 @@ def main(folder: str, classes: list[str] | None) -> None:
     for fold in all_folds:
         chosen = choose_max_distance(fold.train, fold.protocol, options, setup)
         runs = variants(replace(options, max_distance=chosen))
-        database = database_for(fold.train)
+        databases = {name: DATABASES[name](fold.train) for name in {db for db, _ in runs.values()}}
         for trial in fold.test:
             stream = setup.sample(trial.motion, seed=trial.seed)
             height = standing_height(trial.motion)
-            for name, run in runs.items():
-                err, r = run(database, height, trial.motion, stream)
+            for name, (db, run) in runs.items():
+                err, r = run(databases[db], height, trial.motion, stream)
                 rows.setdefault(name, {}).setdefault(trial.cls, []).append(
                     (err["full"], err["hands"], r)
                 )
@@ -148,6 +163,9 @@ def main(folder: str, classes: list[str] | None) -> None:
     for name, per_class in rows.items():
         mean = np.mean([np.mean(v, axis=0) for v in per_class.values()], axis=0)
         print(f"{name:18s} {mean[0]:8.2f} {mean[1]:8.2f} {mean[2]:7.3f}")
+    for name, per_class in rows.items():
+        cells = ", ".join(f"{c} {np.mean(v, axis=0)[0]:.2f}" for c, v in per_class.items())
+        print(f"{name}: full per class: {cells}")
 
 
 if __name__ == "__main__":
