@@ -159,13 +159,7 @@ def main(folder: str, classes: list[str] | None) -> None:
                     (err["full"], err["hands"], r)
                 )
         print(f"{fold.cls} / {fold.held_out}: threshold {chosen}", flush=True)
-    print(f"{'variant':18s} {'full cm':>8s} {'hands cm':>8s} {'hand r':>7s}")
-    for name, per_class in rows.items():
-        mean = np.mean([np.mean(v, axis=0) for v in per_class.values()], axis=0)
-        print(f"{name:18s} {mean[0]:8.2f} {mean[1]:8.2f} {mean[2]:7.3f}")
-    for name, per_class in rows.items():
-        cells = ", ".join(f"{c} {np.mean(v, axis=0)[0]:.2f}" for c, v in per_class.items())
-        print(f"{name}: full per class: {cells}")
+    floors.print_class_means(rows, ("variant", "full cm", "hands cm", "hand r"))
 
 
 if __name__ == "__main__":

@@ -112,7 +112,7 @@ def floor(
 
 def main(folder: str, take: str | None) -> None:
     trials = library_trials(f"{folder}/bandai/dataset-2", class_by="activity")
-    rows: dict[tuple, dict[str, list]] = {}
+    rows: dict[str, dict[str, list]] = {}
     for fold in folds(trials, "cross-trial")[0]:
         if take is not None and fold.held_out != take:
             continue
@@ -126,18 +126,25 @@ def main(folder: str, take: str | None) -> None:
                 for yaw_free in (False, True):
                     for on in SELECTIONS:
                         err = floor(candidates, truth, on, yaw_free)
-                        key = (pool, "yaw-free" if yaw_free else "as is", on)
+                        key = f"{pool} {'yaw-free' if yaw_free else 'as is'} {on}"
                         rows.setdefault(key, {}).setdefault(fold.cls, []).append(
                             (err.mean(), err[HANDS].mean())
                         )
         print(f"{fold.cls} / {fold.held_out}", flush=True)
-    print(f"{'floor':26s} {'full cm':>8s} {'hands cm':>8s}")
-    for key, per_class in rows.items():
+    print_class_means(rows, ("floor", "full cm", "hands cm"))
+
+
+def print_class_means(rows: dict[str, dict[str, list]], header: tuple[str, ...]) -> None:
+    """Print, per row name, the mean over classes of the per-class mean of its tuples
+    (``rows[name][class]`` a list of tuples, one per trial, as many values as ``header``
+    has columns after the name), then the first value per class."""
+    print(f"{header[0]:26s} " + " ".join(f"{h:>8s}" for h in header[1:]))
+    for name, per_class in rows.items():
         mean = np.mean([np.mean(v, axis=0) for v in per_class.values()], axis=0)
-        print(f"{' '.join(key):26s} {mean[0]:8.2f} {mean[1]:8.2f}")
-    for key, per_class in rows.items():
+        print(f"{name:26s} " + " ".join(f"{m:8.3f}" for m in mean))
+    for name, per_class in rows.items():
         cells = ", ".join(f"{c} {np.mean(v, axis=0)[0]:.2f}" for c, v in per_class.items())
-        print(f"{' '.join(key)}: full per class: {cells}")
+        print(f"{name}: {header[1]} per class: {cells}")
 
 
 if __name__ == "__main__":
