@@ -55,8 +55,9 @@ Where the error is, beyond the issue's aim of 2.5 cm full and 2.8 cm hands:
   hand only (raise-up-right-hand 1.83 vs 1.49 without, wave-right-hand 2.04 vs 1.52).
   Fitting each hand's matches on that hand only (``Options.align_own_hand``; §3.1.4's ``s``
   is "the feature vector from the MoCap database", and a feature vector holds one hand,
-  §3.1.2) recovers half of it. Both with the
-  filter off: own-hand alignment 3.17 / 3.27 / 0.914, no alignment 3.04 / 3.26 / 0.915.
+  §3.1.2) recovers half of it. Each with the filter off as well (same folds and
+  thresholds, one-off run): own-hand alignment 3.17 / 3.27 / 0.914, no alignment
+  3.04 / 3.26 / 0.915.
 - The window grid (a pose every 44 ms) costs the floor 0.03-0.26 cm full body.
 - ``--db-headings 2`` (turned copies, beyond the paper) is far worse on Bandai: its root
   ``joint_Root`` is a static identity node and the heading lives in ``Hips``, so a turned
