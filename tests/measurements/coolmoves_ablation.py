@@ -67,6 +67,11 @@ Where the error is, beyond the issue's aim of 2.5 cm full and 2.8 cm hands:
   in the root and -180 deg in the hips, blends of the two turned the body anywhere, and the
   row read 5.52 / 6.79 / 0.838 (run 17.95, walk 12.36).
 
+Together (one-off runs, same folds and thresholds): filter off and 2 headings 2.71 / 2.83 /
+0.919; with own-hand alignment too 2.61 / 2.77 / 0.925, the hands and hand r within the
+issue's aim, full body 0.11 cm above it: run 4.23, walk-turn-left 4.09, walk-turn-right
+3.89 cm remain (their floors 4.66, 3.06, 3.10; yaw-free 3.02, 2.65, 2.65).
+
 History: before the KD-tree fallback of issue 15 the paper row read 3.84 / 4.62 / 0.891; no
 single switch of the pipeline (threshold, limits, EWMA, scaling) moves full body by more than
 0.04 cm, and the reference is within 0.05 cm full of paper mode.
