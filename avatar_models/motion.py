@@ -291,12 +291,26 @@ class Motion:
     def translated(self, delta: np.ndarray) -> Motion:
         return self.replace(root_pos=self.root_pos + np.asarray(delta, dtype=float))
 
-    def rotated_about_z(self, yaw: float) -> Motion:
-        """The whole motion turned by ``yaw`` radians about the world Z axis through the origin."""
+    def rotated_about_z(self, yaw: float, carrier: int = 0) -> Motion:
+        """The whole motion turned by ``yaw`` radians about the world Z axis through the origin.
+
+        ``carrier``: the joint whose local rotation takes the turn (the root by default).
+        Another joint (the hips below a static reference root, as Bandai's ``joint_Root``)
+        turns itself and every joint below it exactly as the root would, while the joints
+        above it keep their rotations and are only moved along: what matters where local
+        rotations of several motions are blended, whose heading must sit in one joint.
+        """
         r = quat.from_axis_angle(np.array([0.0, 0.0, 1.0]), np.array(yaw))
         rot = self.local_rot.copy()
-        rot[:, 0] = quat.mul(r, rot[:, 0])
-        return self.replace(root_pos=quat.rotate(r, self.root_pos), local_rot=rot)
+        if carrier == 0:
+            rot[:, 0] = quat.mul(r, rot[:, 0])
+            return self.replace(root_pos=quat.rotate(r, self.root_pos), local_rot=rot)
+        positions, matrices = self.fk()
+        above = quat.from_matrix(matrices[:, self.skeleton.parents[carrier]])
+        # The carrier's global rotation G becomes r G: its local one A^-1 r A times its own.
+        rot[:, carrier] = quat.mul(quat.mul(quat.conj(above), quat.mul(r, above)), rot[:, carrier])
+        at = positions[:, carrier]
+        return self.replace(root_pos=self.root_pos + quat.rotate(r, at) - at, local_rot=rot)
 
     def __repr__(self) -> str:
         return (

@@ -66,7 +66,8 @@ def alignment_yaw(
         query: ``(B, n, S, 3)`` head-relative positions of ``S`` points (hands) over ``n``
             samples; non-finite values are allowed where ``side_weights`` is 0.
         source: ``(B, K, n, S, 3)`` the ``K`` matched database windows per query.
-        side_weights: ``(B, S)`` extra weight per point (0 drops an untracked hand).
+        side_weights: ``(B, S)`` extra weight per point (0 drops an untracked hand), or
+            ``(B, K, S)`` per match (e.g. one hand's matches fitted on that hand only).
         free_translation: True for the paper's printed equation (the clouds turned about
             their weighted centroids); False turns them about the head (the origin).
     Returns:
@@ -74,14 +75,16 @@ def alignment_yaw(
     """
     n, sides = query.shape[1], query.shape[2]
     if side_weights is None:
-        c = np.broadcast_to(ramp_weights(n)[:, None], (n, sides))[None]  # (1, n, S)
+        cq = np.broadcast_to(ramp_weights(n)[:, None], (n, sides))[None, None]  # (1, 1, n, S)
     else:
-        c = ramp_weights(n)[:, None] * np.asarray(side_weights, float)[:, None, :]  # (B, n, S)
-    query = np.where(c[..., None] > 0, query, 0.0)
+        w = np.asarray(side_weights, float)
+        w = w[:, None] if w.ndim == 2 else w  # (B, 1|K, S)
+        cq = ramp_weights(n)[:, None] * w[:, :, None, :]  # (B, 1|K, n, S)
+    used = cq[:, 0] > 0 if cq.shape[1] == 1 else np.any(cq > 0, axis=1)  # (B|1, n, S)
+    query = np.where(used[..., None], query, 0.0)
     # Our (x, y) are the paper's (z, x): name them as in the paper to keep its formula.
     xq, zq = query[..., 1], query[..., 0]  # (B, n, S)
     xs, zs = source[..., 1], source[..., 0]  # (B, K, n, S)
-    cq = c[:, None]  # (B|1, 1, n, S)
 
     def wsum(a: np.ndarray) -> np.ndarray:
         return np.add.reduce(cq * a, axis=(-2, -1))
@@ -90,7 +93,7 @@ def alignment_yaw(
     num = wsum(xq_ * zs - xs * zq_)
     den = wsum(xq_ * xs + zs * zq_)
     if free_translation:
-        total = np.maximum(c.sum(axis=(1, 2)), 1e-12)[:, None]  # (B|1, 1)
+        total = np.maximum(cq.sum(axis=(-2, -1)), 1e-12)  # (B|1, 1|K)
         num = num - (wsum(xq_) * wsum(zs) - wsum(xs) * wsum(zq_)) / total
         den = den - (wsum(xq_) * wsum(xs) + wsum(zs) * wsum(zq_)) / total
     return np.arctan2(num, den)

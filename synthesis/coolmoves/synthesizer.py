@@ -66,7 +66,9 @@ class Options:
         k: matches per hand. max_distance: KD-tree neighbourhood threshold.
         align: rotation alignment (§3.1.4). align_about_centroid: the paper's printed
             alignment equation (clouds turned about their centroids) instead of about the
-            head (:mod:`.alignment` says why the head is the default).
+            head (:mod:`.alignment` says why the head is the default). align_own_hand: each
+            hand's matches turned to fit that hand's window only (the matched feature vector,
+            §3.1.4's ``s``) instead of both hands' windows of the matched database window.
         smooth: EWMA smoothing. clamp: joint limits.
         matcher: ``"knn"`` (the paper's method) or ``"gmm"`` (the slower mixture variant).
         arm_ik: beyond the paper, the share (0..1) by which each arm is bent with two-bone IK
@@ -82,6 +84,7 @@ class Options:
     max_distance: float = MAX_DISTANCE
     align: bool = True
     align_about_centroid: bool = False
+    align_own_hand: bool = False
     smooth: bool = True
     clamp: bool = True
     matcher: str = "knn"
@@ -181,6 +184,7 @@ class CoolMoves(Synthesizer):
         self.user_height_m = user_height_m
         self._matcher = self._make_matcher()
         self._groups = joint_groups(database.limb_masks)
+        self._match_side = np.repeat(np.eye(2), self.options.k, axis=0)  # (2k, 2) one-hot
         self._group_shares = group_shares(self._groups)
         self._limits = JointLimits(database.skeleton, widen_to=database.poses)
         ref = database.skeleton
@@ -277,7 +281,8 @@ class CoolMoves(Synthesizer):
         safe = np.maximum(entries, 0)
         rotations = db.poses[db.entry_pose[safe]]  # (B, 2k, J, 4), a copy (fancy index)
         if opts.align:
-            yaw = alignment_yaw(windows, db.windows[safe], tracked, opts.align_about_centroid)
+            sides = tracked[:, None, :] * self._match_side if opts.align_own_hand else tracked
+            yaw = alignment_yaw(windows, db.windows[safe], sides, opts.align_about_centroid)
             rotations[:, :, 0] = turn_about_vertical(rotations[:, :, 0], yaw)
         blended = blend_rotations(rotations, weights[:, self._groups, :])  # (B, J, 4)
         matched = (np.add.reduce(weights, axis=-1) > 0)[:, self._groups]  # (B, J)

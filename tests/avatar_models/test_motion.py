@@ -158,6 +158,23 @@ def test_mirror_reflects_positions_and_swaps_sides():
     )
 
 
+def test_turn_carried_by_a_joint_below_a_static_root():
+    """A static reference root above the hips (as Bandai's): turned at the hips, every joint
+    from the hips down lands where turning the whole motion at the root puts it, and the
+    root keeps its rotation."""
+    rng = np.random.default_rng(8)
+    sk = Skeleton(["ref", "hips", "leg"], [-1, 0, 1], [[0, 0, 0], [0.1, 0.2, 0.9], [0, 0, -0.5]])
+    rot = quat.from_scipy(Rotation.random(20 * 3, random_state=rng), (20, 3))
+    rot[:, 0] = quat.IDENTITY
+    m = Motion(sk, 30.0, rng.normal(size=(20, 3)), rot)
+    at_hips, at_root = m.rotated_about_z(0.7, carrier=1), m.rotated_about_z(0.7)
+    np.testing.assert_allclose(
+        at_hips.global_positions()[:, 1:], at_root.global_positions()[:, 1:], atol=1e-12
+    )
+    np.testing.assert_allclose(at_hips.fk()[1][:, 1:], at_root.fk()[1][:, 1:], atol=1e-12)
+    np.testing.assert_array_equal(at_hips.local_rot[:, 0], m.local_rot[:, 0])
+
+
 def test_relative_views():
     m = random_motion(np.random.default_rng(6))
     rel = m.relative_to("head")

@@ -229,6 +229,26 @@ def test_alignment_ignores_untracked_hand():
     assert got[0, 0] == pytest.approx(0.7, abs=1e-9)
 
 
+def test_alignment_per_match_fits_each_hands_own_window():
+    """§3.1.4 aligns "the input feature vector" q and "the feature vector from the MoCap
+    database" s, and a feature vector is one hand's window (§3.1.2): with side weights per
+    match, a left-hand match turns to fit the left hand whatever the right hand of its
+    database window does, a right-hand match the right hand."""
+    rng = np.random.default_rng(5)
+    query = rng.normal(scale=0.3, size=(1, 9, 2, 3))
+    source = rng.normal(scale=0.3, size=(1, 2, 9, 2, 3))  # garbage where not set below
+    source[0, 0, :, 0] = query[0, :, 0] @ yaw_matrix(-0.3).T
+    source[0, 1, :, 1] = query[0, :, 1] @ yaw_matrix(-0.6).T
+    own_hand = np.array([[[1.0, 0.0], [0.0, 1.0]]])  # (B, K, S)
+    np.testing.assert_allclose(alignment_yaw(query, source, own_hand)[0], [0.3, 0.6], atol=1e-9)
+    # Per-match weights equal for every match are the per-query weights.
+    both = np.array([[1.0, 1.0]])
+    np.testing.assert_array_equal(
+        alignment_yaw(query, source, np.repeat(both[:, None], 2, axis=1)),
+        alignment_yaw(query, source, both),
+    )
+
+
 def test_inverse_distance_weights_by_hand():
     w = inverse_distance_weights(np.array([[1.0, 2.0, np.inf], [np.inf, np.inf, np.inf]]))
     np.testing.assert_allclose(w, [[2 / 3, 1 / 3, 0.0], [0.0, 0.0, 0.0]], atol=1e-8)

@@ -45,10 +45,11 @@ def test_database_rejects_bad_input(train_motions):
         build_database(train_motions[:1], correlation_threshold=1.01)
 
 
-@pytest.mark.parametrize("arm_ik", [0.0, 1.0])  # the paper's pipeline, and arm IK on top
-def test_streaming_equals_batch(small_db, stream, arm_ik):
+# The paper's pipeline, arm IK on top, and each hand's matches aligned on that hand.
+@pytest.mark.parametrize("switches", [{}, {"arm_ik": 1.0}, {"align_own_hand": True}])
+def test_streaming_equals_batch(small_db, stream, switches):
     # One core: stepping every sample is bit for bit the batch run.
-    synth = CoolMoves(small_db, TEST_SUBJECT.height_m, Options(arm_ik=arm_ik))
+    synth = CoolMoves(small_db, TEST_SUBJECT.height_m, Options(**switches))
     batch = synth.run(stream)
     synth.reset()
     poses = [synth.step(TrackingFrame.from_stream(stream, i)) for i in range(stream.n_samples)]
@@ -147,10 +148,12 @@ def test_style_sub_library(train_motions):
         style_sub_library(train_motions, "drunk")
 
 
-def test_alignment_undoes_a_turned_database(test_motion, stream):
+@pytest.mark.parametrize("own_hand", [False, True])
+def test_alignment_undoes_a_turned_database(test_motion, stream, own_hand):
     """The database is the test motion itself turned by 40 deg: without alignment every
     match faces the wrong way; alignment turns them back (the KD-tree still searches in world
-    axes, as the paper's unnormalised features do, so not every match is the right one)."""
+    axes, as the paper's unnormalised features do, so not every match is the right one),
+    fitting both hands or each match's own hand."""
     database = build_database([test_motion.rotated_about_z(np.radians(40.0))])
     height = standing_height(test_motion)
 
@@ -158,7 +161,7 @@ def test_alignment_undoes_a_turned_database(test_motion, stream):
         opts = Options(smooth=False, arm_ik=0.0, **switches)
         return body17_errors_cm(CoolMoves(database, height, opts).run(stream), test_motion)["full"]
 
-    assert full_error(align=True) < 0.85 * full_error(align=False)
+    assert full_error(align=True, align_own_hand=own_hand) < 0.85 * full_error(align=False)
 
 
 def test_alignment_helps_a_user_facing_another_way(small_db, test_motion):

@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
-from synthesis.evaluate import EvaluationError, Trial, folds
+from avatar_models import quat
+from avatar_models.generator import generate
+from synthesis.evaluate import EvaluationError, Trial, database_for, folds
 
 
 def _trial(cls, subject, take, motion=None):
@@ -49,3 +52,19 @@ def test_class_with_one_subject_is_skipped_with_a_reason():
     assert "swim" in skipped and "at least 2" in skipped["swim"]
     with pytest.raises(EvaluationError, match="unknown protocol"):
         folds(trials, "cross-everything")
+
+
+def test_turned_database_copies_keep_a_static_root_static():
+    """The generated rig's root (``Bip01``) is a static node above the pelvis, which carries
+    the heading: copies turned to other headings turn the pelvis too, so that every stored
+    pose keeps one root rotation and blending local rotations never mixes two conventions."""
+    walk = generate("walk", duration_s=1.0, fps=30.0)
+    assert np.ptp(walk.local_rot[:, 0], axis=0).max() == 0.0
+    database = database_for([_trial("walk", "a", 1, walk)], headings=4)
+    roots = database.poses[:, 0]
+    np.testing.assert_allclose(np.abs(quat.dot(roots, walk.local_rot[0, 0])), 1.0, atol=1e-12)
+    # and the pelvis faces all four ways
+    facing = quat.rotate(database.poses[:, 1], np.array([1.0, 0.0, 0.0]))
+    yaws = np.degrees(np.arctan2(facing[:, 1], facing[:, 0]))
+    for heading in (0.0, 90.0, 180.0, -90.0):
+        assert np.any(np.abs((yaws - heading + 180.0) % 360.0 - 180.0) < 30.0)
