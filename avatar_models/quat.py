@@ -51,9 +51,11 @@ def mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     # ``aw bw - ax bx - ay by - az bz, ...`` to the bit, in a handful of numpy calls where
     # sixteen products and a stack took thirty (quat.mul runs in every IK step). b.take,
     # not b[..., _MUL_ORDER]: the same gather without advanced indexing's set-up (a third
-    # of a tick-sized product's time).
+    # of a tick-sized product's time). The rows are summed by one reduction over the row
+    # axis, which numpy adds row after row (an outer axis: no pairwise summation), so the
+    # order stays the textbook's, in one call where three additions took three.
     terms = a[..., :, None] * (b.take(_MUL_ORDER, axis=-1) * _MUL_SIGNS)  # (..., 4, 4)
-    return ((terms[..., 0, :] + terms[..., 1, :]) + terms[..., 2, :]) + terms[..., 3, :]
+    return np.add.reduce(terms, axis=-2)
 
 
 def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -90,7 +92,10 @@ def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``a x b`` over the last axis ``(..., 3)``: ``(ay bz - az by, az bx - ax bz,
     ax by - ay bx)``, by permuted components (np.cross's moveaxis set-up costs more than
     the arithmetic on a step's few vectors; it was most of AvatarGo's goals)."""
-    return a[..., _YZX] * b[..., _ZXY] - a[..., _ZXY] * b[..., _YZX]
+    # take, not a[..., _YZX]: the same gather without advanced indexing's set-up.
+    return a.take(_YZX, axis=-1) * b.take(_ZXY, axis=-1) - a.take(_ZXY, axis=-1) * b.take(
+        _YZX, axis=-1
+    )
 
 
 def to_matrix(q: np.ndarray) -> np.ndarray:
