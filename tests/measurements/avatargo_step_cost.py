@@ -27,7 +27,11 @@ the analytic solve 410-440 of which the two-bone solve 160-190, the palm distanc
 the devices' normalisation 17, the fingers 13. About a third of the tick is in
 :mod:`avatar_models.quat` (10 ``mul``, 6 ``cross``, 2 ``from_axis_angle``, 4
 ``unit_to_matrix``): ``mul`` summing its four rows by one ``np.add.reduce(axis=-2)`` and
-``cross`` gathering by ``take`` give the same bits here, at ~5 us less a call each.
+``cross`` gathering by ``take`` give the same bits here, at ~5 us less a call each (applied
+in e730313; ``compare``: every array still equal to the bit).
+
+Merged main (e730313), ``avatarsim bench avatargo`` three times at load 0.47-0.59 (no other
+job): analytic step p50 0.51-0.53 ms, p99 0.58-0.68 ms wall, CPU p99 0.57-0.67 ms.
 """
 
 from __future__ import annotations
