@@ -178,6 +178,11 @@ METHODS: dict[str, Method] = {
             "CoolMoves aligning about the clouds' centroids (the printed equation)",
             Options(align_about_centroid=True),
         ),
+        coolmoves(
+            "coolmoves-own-hand-align",
+            "CoolMoves turning each hand's matches to fit that hand's window only",
+            Options(align_own_hand=True),
+        ),
         Method("ik", "VRIK-like full-body IK from headset and controllers (§4.1.1)", ik_baseline),
         avatargo(
             "avatargo",

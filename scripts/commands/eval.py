@@ -36,6 +36,10 @@ def _table(results: dict) -> Table:
     turned = f", test turned up to {results['heading_deg']:g} deg" if results["heading_deg"] else ""
     if results["db_headings"] > 1:
         turned += f", database at {results['db_headings']} headings"
+    from synthesis.coolmoves.correlation import CORRELATION_THRESHOLD
+
+    if results["correlation_threshold"] != CORRELATION_THRESHOLD:
+        turned += f", hand-foot filter at {results['correlation_threshold']:g}"
     table = Table(
         title=f"{results['method']} {results['protocol']}{turned} (cm; IK baseline in brackets)"
     )
@@ -257,7 +261,8 @@ def register(app: typer.Typer) -> None:
             str,
             typer.Argument(
                 help="coolmoves (the paper's), coolmoves+arm-ik, coolmoves-gmm, "
-                "coolmoves-centroid-align (synthesis.methods), leaderboard: every "
+                "coolmoves-centroid-align, coolmoves-own-hand-align (synthesis.methods), "
+                "leaderboard: every "
                 "registered method on the same test motions, accuracy, physics and latency, "
                 "or avatargo: its simulated user study, exact vs fixed offsets (one user "
                 "per test motion), "
@@ -290,6 +295,13 @@ def register(app: typer.Typer) -> None:
         db_headings: Annotated[
             int, typer.Option(help="Database copies turned to this many yaws (beyond the paper).")
         ] = 1,
+        correlation_threshold: Annotated[
+            float | None,
+            typer.Option(
+                help="Hand-foot filter threshold of the database (default: the paper's 0.1; "
+                "another value goes beyond the paper, -1 keeps every trial)."
+            ),
+        ] = None,
         quick: Annotated[bool, typer.Option(help="Small inputs, for a smoke run.")] = False,
         methods: Annotated[
             str | None,
@@ -342,6 +354,7 @@ def register(app: typer.Typer) -> None:
             evaluate_command(model, data, no_vr_model, frame_stride, out, json_out, mocap)
             return
         from scripts.leaderboard import run_leaderboard
+        from synthesis.coolmoves.correlation import CORRELATION_THRESHOLD
         from synthesis.evaluate import (
             EVALUABLE,
             PROTOCOLS,
@@ -359,11 +372,17 @@ def register(app: typer.Typer) -> None:
             ("--duration", duration, 0.5, 600.0),
             ("--heading", heading, 0.0, 180.0),
             ("--db-headings", db_headings, 1, 36),
+            (
+                "--correlation-threshold",
+                0.0 if correlation_threshold is None else correlation_threshold,
+                -1.0,
+                1.0,
+            ),
             ("--max-per-class", 1 if max_per_class is None else max_per_class, 1, 100_000),
             ("--workers", workers, 1, 256),
         ):
             if not lo <= value <= hi:  # also NaN
-                raise EvaluationError(f"{option} must be {lo:g}-{hi:g}, got {value}")
+                raise EvaluationError(f"{option} must be from {lo:g} to {hi:g}, got {value}")
         # Every method, MoveBox too: a typo is not silently run as the default.
         if protocol not in PROTOCOLS:
             raise EvaluationError(f"unknown protocol {protocol!r}; use {' or '.join(PROTOCOLS)}")
@@ -447,6 +466,11 @@ def register(app: typer.Typer) -> None:
                 progress=progress,
                 heading_deg=heading,
                 db_headings=db_headings,
+                correlation_threshold=(
+                    CORRELATION_THRESHOLD
+                    if correlation_threshold is None
+                    else correlation_threshold
+                ),
             )
         results.update(
             library=library, seed=seed, quick=quick, class_by=class_by, trials_total=len(trials)

@@ -25,6 +25,7 @@ from render_cams import VRSetup
 from render_cams.vr import HEADSET_AND_CONTROLLERS, Attachment
 from synthesis.base import SynthesisError
 from synthesis.coolmoves import CoolMoves, Database
+from synthesis.coolmoves.correlation import CORRELATION_THRESHOLD
 from synthesis.evaluate.folds import Fold, database_for, folds
 from synthesis.evaluate.trials import EvaluationError, Trial, turned
 from synthesis.evaluate.validation import choose_max_distance
@@ -87,6 +88,7 @@ def evaluate_fold(
     heading_deg: float = 0.0,
     db_headings: int = 1,
     tune: bool = True,
+    correlation_threshold: float = CORRELATION_THRESHOLD,
 ) -> list[dict]:
     """Per test trial of ``fold``: the CoolMoves variant ``method``, its ablation variants
     (switched from the variant's options) and the IK baseline.
@@ -94,13 +96,16 @@ def evaluate_fold(
     ``heading_deg``: turn each test motion by a random yaw up to this (:func:`turned`);
     ``db_headings``: turned copies of the database (:func:`database_for`); ``tune``: the
     distance threshold chosen on the fold's training data
-    (:func:`~synthesis.evaluate.validation.choose_max_distance`; each row records it).
+    (:func:`~synthesis.evaluate.validation.choose_max_distance`; each row records it);
+    ``correlation_threshold``: the hand-foot filter of the fold's database (the paper's 0.1;
+    another value goes beyond the paper; the distance threshold is still chosen on the
+    paper's validation database, as with ``db_headings``).
     """
     options = method.options
     if tune:
         chosen = choose_max_distance(fold.train, fold.protocol, options, setup)
         options = replace(options, max_distance=chosen)
-    database = database_for(fold.train, db_headings)
+    database = database_for(fold.train, db_headings, correlation_threshold)
     cache = {} if baseline_cache is None else baseline_cache
     rows = []
     for trial in fold.test:
@@ -183,6 +188,7 @@ def run_protocol(
     heading_deg: float = 0.0,
     db_headings: int = 1,
     tune: bool = True,
+    correlation_threshold: float = CORRELATION_THRESHOLD,
 ) -> dict:
     """Evaluate ``method`` on ``trials`` under ``protocol``.
 
@@ -193,7 +199,9 @@ def run_protocol(
     ``progress(done, total, label)`` is called after every fold. ``heading_deg`` turns each
     test motion by a random yaw up to this (the database keeps its headings);
     ``db_headings > 1`` adds turned copies to each fold's database (:func:`database_for`);
-    ``tune`` chooses the distance threshold per fold on its training data.
+    ``tune`` chooses the distance threshold per fold on its training data;
+    ``correlation_threshold`` replaces the paper's hand-foot filter threshold
+    (:func:`evaluate_fold`; -1 keeps every trial).
     """
     if method not in EVALUABLE:
         raise EvaluationError(f"unknown method {method!r}; available: {', '.join(EVALUABLE)}")
@@ -208,7 +216,15 @@ def run_protocol(
         try:
             rows.extend(
                 evaluate_fold(
-                    fold, METHODS[method], setup, ablation, cache, heading_deg, db_headings, tune
+                    fold,
+                    METHODS[method],
+                    setup,
+                    ablation,
+                    cache,
+                    heading_deg,
+                    db_headings,
+                    tune,
+                    correlation_threshold,
                 )
             )
         except SynthesisError as exc:  # e.g. every training clip fails the correlation filter
@@ -231,5 +247,6 @@ def run_protocol(
         "folds": len(all_folds),
         "heading_deg": heading_deg,
         "db_headings": db_headings,
+        "correlation_threshold": correlation_threshold,
         "paper": PAPER,
     }

@@ -220,6 +220,7 @@ def test_absurd_numbers_exit_2(tmp_path, clip):
     bad(["render", str(clip), "--size", "40000,30000", "--out", out], "--size", "16-4096")
     bad(["render", str(clip), "--fov", "nan,90", "--out", out], "--fov")
     bad(["eval", "coolmoves", "--duration", "inf", "--out", out], "--duration")
+    bad(["eval", "coolmoves", "--correlation-threshold", "nan", "--out", out], "-1 to 1")
     assert not (tmp_path / "o").exists() and not (tmp_path / "x.bvh").exists()
 
 
