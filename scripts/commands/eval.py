@@ -33,11 +33,11 @@ from scripts.cli_common import (
 
 
 def _table(results: dict) -> Table:
+    from synthesis.coolmoves.correlation import CORRELATION_THRESHOLD
+
     turned = f", test turned up to {results['heading_deg']:g} deg" if results["heading_deg"] else ""
     if results["db_headings"] > 1:
         turned += f", database at {results['db_headings']} headings"
-    from synthesis.coolmoves.correlation import CORRELATION_THRESHOLD
-
     if results["correlation_threshold"] != CORRELATION_THRESHOLD:
         turned += f", hand-foot filter at {results['correlation_threshold']:g}"
     table = Table(
@@ -366,18 +366,15 @@ def register(app: typer.Typer) -> None:
         from synthesis.methods import METHODS
         from synthesis.report_plots import write_plots
 
+        if correlation_threshold is None:
+            correlation_threshold = CORRELATION_THRESHOLD
         for option, value, lo, hi in (
             ("--subjects", subjects, 1, 50),
             ("--takes", takes, 1, 20),
             ("--duration", duration, 0.5, 600.0),
             ("--heading", heading, 0.0, 180.0),
             ("--db-headings", db_headings, 1, 36),
-            (
-                "--correlation-threshold",
-                0.0 if correlation_threshold is None else correlation_threshold,
-                -1.0,
-                1.0,
-            ),
+            ("--correlation-threshold", correlation_threshold, -1.0, 1.0),
             ("--max-per-class", 1 if max_per_class is None else max_per_class, 1, 100_000),
             ("--workers", workers, 1, 256),
         ):
@@ -466,11 +463,7 @@ def register(app: typer.Typer) -> None:
                 progress=progress,
                 heading_deg=heading,
                 db_headings=db_headings,
-                correlation_threshold=(
-                    CORRELATION_THRESHOLD
-                    if correlation_threshold is None
-                    else correlation_threshold
-                ),
+                correlation_threshold=correlation_threshold,
             )
         results.update(
             library=library, seed=seed, quick=quick, class_by=class_by, trials_total=len(trials)

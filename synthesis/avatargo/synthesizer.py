@@ -32,8 +32,9 @@ Each tick (§3.4), by the per-tick IK ``solver`` (:data:`SOLVERS`):
   0.85-1.01 ms (before 1.29-1.41), p99 1.48-1.86 ms (before 1.85-2.09), but mink's, whose
   tick barely changed, moved as much (p50 1.85-2.48 against 2.85-3.19): the machine's
   drift; per frame the best of 5 passes (``tests/measurements/avatargo_step_cost.py timing
-  5``, four alternations) p50 0.63-0.66 ms against 0.70-1.09. The 1 ms p99 aim is not
-  shown there (the tail is the machine's, see :mod:`scripts.benchmarks.avatargo`). Feet
+  5``, four alternations) p50 0.63-0.66 ms against 0.70-1.09. With no other job (load
+  0.5, three runs, after quat's cheaper ``mul``/``cross``): p50 0.51-0.53 ms, p99
+  0.58-0.68 ms wall and CPU, under the 1 ms aim. Feet
   and root on their goals: built-in study (30 users, realistic noise) 0.67 / 0.62 cm mean,
   against mink's 1.4-1.7 / 2.2 cm; the head by forward kinematics 0.63 cm (mink 0.68).
 - ``"mink"`` or ``"least-squares"`` (:data:`QP_SOLVERS`): full-body IK on the avatar's
