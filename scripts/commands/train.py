@@ -18,6 +18,9 @@ from scripts.cli_common import (
     user_errors,
 )
 
+OPTIONS = {"time_budget_s": "--time-budget", "use_vr": "--vr"}
+"""Options whose name is not the config field's (``max_epochs`` is ``--max-epochs``)."""
+
 
 def register(app: typer.Typer) -> None:
     group = make_app()
@@ -59,28 +62,28 @@ def register(app: typer.Typer) -> None:
         """Train the ControllerPose lifting network (§4.3) on CPU: curves in RUN/loss.png,
         checkpoint in RUN/checkpoint.pt (resumable), summary in RUN/train.json."""
         from avatar_models.errors import AvatarsimError
-        from scripts.controllerpose.training import run_training
-        from synthesis.controllerpose.network import NetConfig
+        from scripts.controllerpose.training import check_fits, run_training
+        from synthesis.controllerpose.network import ConfigValueError, NetConfig
         from synthesis.controllerpose.train import TrainConfig
 
-        for name, value in (
-            ("--max-epochs", max_epochs),
-            ("--frame-stride", frame_stride),
-            ("--width", width),
-            ("--threads", threads),
-        ):
+        for name, value in (("--max-epochs", max_epochs), ("--frame-stride", frame_stride)):
             if value < 1:
                 raise AvatarsimError(f"{name} must be at least 1, got {value}")
+        try:
+            net = NetConfig(width=width, blocks=blocks, use_vr=vr)
+            config = TrainConfig(
+                max_epochs=max_epochs,
+                patience=patience,
+                position_weight=position_weight,
+                time_budget_s=time_budget,
+                seed=seed,
+                threads=threads,
+            )
+        except ConfigValueError as exc:
+            option = OPTIONS.get(exc.field, "--" + exc.field.replace("_", "-"))
+            raise AvatarsimError(f"{option} {exc.reason}") from None
+        check_fits(net, config)
         check_outputs(json_out=json_out, out=out)
-        net = NetConfig(width=width, blocks=blocks, use_vr=vr)
-        config = TrainConfig(
-            max_epochs=max_epochs,
-            patience=patience,
-            position_weight=position_weight,
-            time_budget_s=time_budget,
-            seed=seed,
-            threads=threads,
-        )
         summary = run_training(data, out, net, config, frame_stride, console.print)
         best = summary["best_val"]
         console.print(

@@ -9,11 +9,13 @@ config resumes it, with the new stopping rule (``--max-epochs``, ``--time-budget
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from avatar_models.errors import AvatarsimError
 from avatar_models.fileio import write_json
 from scripts.controllerpose.data import load_examples, manifest_sha256
 from scripts.controllerpose.figures import plt, save_png
@@ -49,6 +51,29 @@ def resumable(out: Path, net: NetConfig, config: TrainConfig, sha: str):
     if previous.net != net:
         raise CheckpointError(f"{out} holds a run of another network ({previous.net})")
     return previous
+
+
+def machine_memory_bytes() -> int:
+    """This machine's physical memory."""
+    return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+
+
+def check_fits(net: NetConfig, config: TrainConfig, memory: int | None = None) -> None:
+    """Before any work: training ``net`` needs less than ``memory`` bytes (default: the
+    machine's), by :meth:`~synthesis.controllerpose.network.NetConfig.training_bytes`.
+
+    Raises:
+        AvatarsimError: the estimate, the memory and the sizes that make it.
+    """
+    memory = machine_memory_bytes() if memory is None else memory
+    need = net.training_bytes(config.batch_size)
+    if need > memory:
+        raise AvatarsimError(
+            f"a network of --width {net.width} and --blocks {net.blocks} "
+            f"({net.state_size():,} numbers) needs about {need / 2**30:.1f} GiB to train, "
+            f"more than this machine's {memory / 2**30:.1f} GiB; choose fewer blocks or a "
+            "smaller width"
+        )
 
 
 def plot_losses(history: list[dict[str, float]], path: Path) -> None:

@@ -4,12 +4,17 @@
 (:data:`~.features.LAYOUT`), the network's config and weights (the best on validation so
 far, and the latest with the optimiser for resuming), the feature normaliser, the bone
 lengths template, the training config and seed, the dataset manifest's sha256, the epoch
-and the loss history. :func:`load` refuses a file from another feature layout.
+and the loss history: tensors and plain Python data only (arrays are stored as tensors).
+
+A checkpoint is data, never code: :func:`load` reads it with ``torch.load(weights_only=True)``
+(no object is constructed from the file, nothing in it runs) and checks every field against
+:mod:`.checkpoint_schema` (layout, sizes, layer shapes, finite weights) before use.
 """
 
 from __future__ import annotations
 
 import os
+import pickle
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,16 +23,13 @@ from typing import Any
 import numpy as np
 import torch
 
-from avatar_models import AvatarsimError
+from synthesis.controllerpose.checkpoint_schema import FORMAT, CheckpointError, check_payload
 from synthesis.controllerpose.features import LAYOUT
 from synthesis.controllerpose.network import LiftingNet, NetConfig
 from synthesis.controllerpose.normaliser import Normaliser
 
 FILE = "checkpoint.pt"
-
-
-class CheckpointError(AvatarsimError, ValueError):
-    """A checkpoint that is missing, unreadable or from another feature layout."""
+__all__ = ["FILE", "Checkpoint", "CheckpointError", "load", "untrained"]
 
 
 @dataclass
@@ -66,11 +68,12 @@ class Checkpoint:
         """Writes ``folder/checkpoint.pt`` atomically; returns its path."""
         folder.mkdir(parents=True, exist_ok=True)
         payload = {
+            "format": FORMAT,
             "layout": LAYOUT,
             "net": self.net.as_dict(),
             "best_weights": self.best_weights,
-            "normaliser": self.normaliser.state(),
-            "template_lengths": self.template_lengths,
+            "normaliser": {k: torch.from_numpy(v) for k, v in self.normaliser.state().items()},
+            "template_lengths": torch.from_numpy(np.asarray(self.template_lengths, np.float64)),
             "train": self.train,
             "seed": self.train.get("seed"),
             "manifest_sha256": self.manifest_sha256,
@@ -110,10 +113,12 @@ def untrained(
 
 
 def load(folder: str | Path) -> Checkpoint:
-    """The checkpoint in run folder ``folder`` (or the file itself).
+    """The checkpoint in run folder ``folder`` (or the file itself), checked
+    (:mod:`.checkpoint_schema`).
 
     Raises:
-        CheckpointError: no checkpoint, unreadable, or another feature layout.
+        CheckpointError: no checkpoint, unreadable, holding anything but tensors and plain
+            data, another feature layout, or a field that does not match its schema.
     """
     path = Path(folder)
     path = path / FILE if path.is_dir() else path
@@ -122,23 +127,32 @@ def load(folder: str | Path) -> Checkpoint:
             f"no ControllerPose checkpoint at {path} (train one: avatarsim train controllerpose)"
         )
     try:
-        payload = torch.load(path, map_location="cpu", weights_only=False)
-    except Exception as exc:  # torch raises many kinds for a damaged file
-        raise CheckpointError(f"{path}: not a readable checkpoint ({exc})") from exc
-    if not isinstance(payload, dict) or payload.get("layout") != LAYOUT:
-        found = payload.get("layout") if isinstance(payload, dict) else None
+        payload = torch.load(path, map_location="cpu", weights_only=True)
+    except pickle.UnpicklingError as exc:
+        # torch's message advises weights_only=False; only its line naming the object is kept
+        lines = str(exc).splitlines()
+        reason = next((x for x in lines if "GLOBAL" in x or "Unsupported" in x), type(exc).__name__)
         raise CheckpointError(
-            f"{path}: feature layout {found} is not this version's {LAYOUT}; retrain with "
-            "avatarsim train controllerpose"
-        )
+            f"{path}: holds Python objects, not only tensors and plain data; a checkpoint is "
+            f"data, never code, so it is not loaded ({_one_line(reason)}); retrain with "
+            "avatarsim train controllerpose or ask for a checkpoint of this version"
+        ) from None
+    except Exception as exc:  # torch raises many kinds for a damaged file
+        raise CheckpointError(f"{path}: not a readable checkpoint ({_one_line(exc)})") from None
+    p = check_payload(payload, path)
+    normaliser = {k: v.numpy().astype(np.float32) for k, v in p["normaliser"].items()}
     return Checkpoint(
-        NetConfig(**payload["net"]),
-        payload["best_weights"],
-        Normaliser(**payload["normaliser"]),
-        np.asarray(payload["template_lengths"]),
-        payload["train"],
-        payload["manifest_sha256"],
-        payload["epoch"],
-        payload["history"],
-        payload["resume"],
+        p["net"],
+        p["best_weights"],
+        Normaliser(**normaliser),
+        p["template_lengths"].numpy().astype(np.float64),
+        p["train"],
+        p["manifest_sha256"],
+        int(p["epoch"]),
+        p["history"],
+        p["resume"],
     )
+
+
+def _one_line(text: object) -> str:
+    return " ".join(str(text).split())[:300]

@@ -20,18 +20,26 @@ import numpy as np
 import torch
 from torch import nn
 
+from synthesis.base import SynthesisError
 from synthesis.controllerpose.checkpoint import Checkpoint
 from synthesis.controllerpose.examples import Examples
 from synthesis.controllerpose.fk import forward_kinematics
-from synthesis.controllerpose.network import LiftingNet, NetConfig
+from synthesis.controllerpose.network import LiftingNet, NetConfig, check_int, check_real
 from synthesis.controllerpose.normaliser import Normaliser
 
 EVAL_CHUNK = 4096
 
 
+class TrainingDiverged(SynthesisError):
+    """The loss went non-finite during training (a learning rate or loss weight too large)."""
+
+
 @dataclass(frozen=True)
 class TrainConfig:
-    """How to train (defaults: §4.3 where the paper says, ours where it does not)."""
+    """How to train (defaults: §4.3 where the paper says, ours where it does not). Checked on
+    construction (:class:`~.network.ConfigValueError`): rates and weights finite and not
+    negative, the learning rate and time budget positive, counts at least 1 (a batch at
+    least 2: batch normalisation; ``max_epochs`` 0: the untrained network)."""
 
     lr: float = 1e-3
     lr_decay: float = 5e-6
@@ -42,6 +50,18 @@ class TrainConfig:
     time_budget_s: float | None = None
     seed: int = 0
     threads: int = 1
+
+    def __post_init__(self) -> None:
+        check_real("lr", self.lr, 0.0, strict=True)
+        check_real("lr_decay", self.lr_decay, 0.0)
+        check_int("batch_size", self.batch_size, 2)
+        check_int("max_epochs", self.max_epochs, 0)
+        check_int("patience", self.patience, 1)
+        check_real("position_weight", self.position_weight, 0.0)
+        if self.time_budget_s is not None:
+            check_real("time_budget_s", self.time_budget_s, 0.0, strict=True)
+        check_int("seed", self.seed, 0)
+        check_int("threads", self.threads, 1)
 
     def as_dict(self) -> dict:
         return asdict(self)
@@ -102,6 +122,17 @@ def position_error(angles: torch.Tensor, data: dict[str, torch.Tensor]) -> torch
     """MSE (m^2) of the keypoints FK places from ``angles (B, 43)`` with the true lengths."""
     positions = forward_kinematics(angles, data["lengths"])
     return nn.functional.mse_loss(positions, data["positions"])
+
+
+def check_loss(loss: torch.Tensor, where: str) -> None:
+    """Raises :class:`TrainingDiverged` when ``loss`` is NaN or infinite: the weights of the
+    step that made it are garbage, and every later step would be too."""
+    if not bool(torch.isfinite(loss)):
+        raise TrainingDiverged(
+            f"training diverged: the loss is {float(loss)} at {where}; the checkpoint of the "
+            "last finished epoch (if any) is kept. Lower the learning rate or the position "
+            "weight"
+        )
 
 
 def batch(data: dict[str, torch.Tensor], index: torch.Tensor) -> dict[str, torch.Tensor]:
@@ -165,6 +196,7 @@ def train(
                 continue
             out_angles = model(data["skeletons"], data["found"], data["vr"])
             terms = losses(out_angles, data, config.position_weight)
+            check_loss(terms["loss"], f"epoch {epoch + 1}, batch {steps + 1}")
             optimiser.zero_grad()
             terms["loss"].backward()
             optimiser.step()
@@ -175,6 +207,7 @@ def train(
         val_angles = predict(model, val_data)
         val_terms = losses(val_angles, val_data, config.position_weight)
         val_terms["position_mse"] = position_error(val_angles, val_data)
+        check_loss(val_terms["loss"], f"epoch {epoch + 1}, validation")
         val_loss = float(val_terms["loss"])
         elapsed = time.perf_counter() - start
         record = {

@@ -64,7 +64,7 @@ def test_a_dataset_without_keypoints_exits_2(tmp_path):
 
 
 def test_a_checkpoint_of_another_feature_layout_exits_2(cp_run, cp_dataset, tmp_path):
-    payload = torch.load(cp_run / "checkpoint.pt", weights_only=False)
+    payload = torch.load(cp_run / "checkpoint.pt", weights_only=True)
     payload["layout"] = {**payload["layout"], "skeleton_slots": 2}
     (tmp_path / "old").mkdir()
     torch.save(payload, tmp_path / "old" / "checkpoint.pt")

@@ -53,7 +53,7 @@ def test_same_seed_same_weights_and_resume_equals_uninterrupted(tiny_examples, t
 def test_a_checkpoint_of_another_feature_layout_is_refused(tiny_examples, tmp_path):
     checkpoint = train(tiny_examples, tiny_examples, TINY_NET, replace(SHORT, max_epochs=1))
     path = checkpoint.save(tmp_path)
-    payload = torch.load(path, weights_only=False)
+    payload = torch.load(path, weights_only=True)
     payload["layout"] = {**payload["layout"], "per_skeleton": 153}
     torch.save(payload, path)
     with pytest.raises(CheckpointError, match="feature layout"):
