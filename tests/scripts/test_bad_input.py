@@ -14,9 +14,16 @@ from typer.testing import CliRunner
 from avatar_models.formats import save_motion
 from avatar_models.generator import generate
 from scripts.cli import app
+from tests.conftest import require
 
 runner = CliRunner()
-CMU_09_01 = Path(__file__).resolve().parents[2].parent / "shared" / "mocap" / "cmu" / "09_01.bvh"
+
+
+def cmu_09_01(mocap_dir: Path) -> Path:
+    """CMU 09_01 (a run with a T-pose first frame), under :func:`require`."""
+    clip = mocap_dir / "cmu" / "09_01.bvh"
+    require(clip.is_file(), f"{clip} is absent")
+    return clip
 
 
 def bad(args: list[str], *expected: str) -> None:
@@ -277,10 +284,9 @@ def test_a_wrong_unit_giving_no_persons_height_exits_2(tmp_path):
 
 
 @pytest.mark.mocap
-def test_cmu_in_millimetres_names_the_cmu_unit():
-    if not CMU_09_01.is_file():
-        pytest.skip("shared/mocap is absent")
-    bad(["check", str(CMU_09_01), "--unit", "mm"], "0.0", "--unit cmu")
+def test_cmu_in_millimetres_names_the_cmu_unit(mocap_dir):
+    clip = cmu_09_01(mocap_dir)
+    bad(["check", str(clip), "--unit", "mm"], "0.0", "--unit cmu")
 
 
 # -- malformed files and messages ----------------------------------------------------------
@@ -372,18 +378,17 @@ def test_a_prepended_rest_pose_frame_is_dropped_and_reported(tmp_path):
 
 
 @pytest.mark.mocap
-def test_cmu_09_01_loses_its_t_pose_frame_and_its_residual_spike(tmp_path):
+def test_cmu_09_01_loses_its_t_pose_frame_and_its_residual_spike(tmp_path, mocap_dir):
     from avatar_models.formats import load_motion
 
-    if not CMU_09_01.is_file():
-        pytest.skip("shared/mocap is absent")
-    m = load_motion(CMU_09_01)
-    raw = load_motion(CMU_09_01, drop_rest_frame=False)
+    clip = cmu_09_01(mocap_dir)
+    m = load_motion(clip)
+    raw = load_motion(clip, drop_rest_frame=False)
     assert raw.n_frames == 149 and m.n_frames == 148
     assert "rest pose" in m.meta["dropped_frames"]["reason"]
     assert np.allclose(m.local_rot, raw.local_rot[1:])
     out = tmp_path / "o"
-    result = runner.invoke(app, ["check", str(CMU_09_01), "--out", str(out)])
+    result = runner.invoke(app, ["check", str(clip), "--out", str(out)])
     assert result.exit_code in (0, 1), result.output
     rows = np.genfromtxt(out / "check.csv", delimiter=",", names=True)
     residual = [n for n in rows.dtype.names if n.startswith("residual")][0]

@@ -11,13 +11,13 @@ import pytest
 from avatar_models.generator import Subject, generate
 from synthesis.coolmoves.correlation import hand_foot_correlation, keeps
 from synthesis.coolmoves.database import hands_and_feet
+from tests.conftest import require
 from tests.measurements.hand_foot_correlation import cmu_scores
 
 
 @pytest.mark.mocap
 def test_papers_observations_on_cmu(mocap_dir):
-    if not (mocap_dir / "cmu").is_dir():
-        pytest.skip("no CMU clips")
+    require((mocap_dir / "cmu").is_dir(), f"no CMU clips in {mocap_dir / 'cmu'}")
     scores = {k: np.asarray(v) for k, v in cmu_scores(mocap_dir).items()}
     assert scores["basketball"].mean() > 0.5 and scores["climbing"].mean() > 0.5
     assert scores["swimming"].mean() < 0.2

@@ -13,6 +13,7 @@ from avatar_models.rigs import body17_positions
 from render_cams import VRSetup
 from synthesis.base import SynthesisError
 from synthesis.ik_baseline import IKBaseline, Stepper
+from tests.conftest import require
 
 TRACKED = body17.group_indices(("head", "l_wrist", "r_wrist"))
 # THRESHOLDS of the tracked joints' error on noise-free targets, from the spread over seeds
@@ -167,8 +168,7 @@ def test_real_clip_of_each_source_stands_and_steps(mocap_dir, clip):
     from synthesis.scoring import score_run
 
     path = mocap_dir / clip
-    if not path.is_file():
-        pytest.skip(f"{path} is absent")
+    require(path.is_file(), f"{path} is absent")
     motion = load_motion(path)
     motion = motion[1 if clip.startswith("cmu/") else 0 :][: int(3.0 * motion.fps)]
     setup = VRSetup()

@@ -9,7 +9,7 @@ import pytest
 from avatar_models.generator import sample_subject
 from avatar_models.generator.subject import subject_skeleton
 from avatar_models.rigs import load_rig
-from synthesis.avatargo.fingers import FingerIK, capsule_sdf
+from synthesis.avatargo.fingers import FingerIK, capsule_sdf, finger_points
 from synthesis.avatargo.hands import CONTROLLER_RADIUS_M, grip_of
 
 
@@ -44,6 +44,12 @@ def test_thumb_button_pulls_the_thumb():
     tips = [ik.sdf(ik.advance()) for ik in (free, pressing)]
     assert not np.allclose(pressing.t[[0, 5]], free.t[[0, 5]])
     assert tips[1].min() > -0.002
+    # Each thumb tip ends nearer its button than the free thumb's: the pull's direction. The
+    # handle's penalty holds the thumb almost open, so the pull gains little (69.26 mm free,
+    # 69.11 mm pressing, deterministic), and a reversed pull would push it further away.
+    gap = [np.linalg.norm(finger_points(ik.rig, ik.t)[::5, 2] - button, axis=-1) for ik in
+           (free, pressing)]  # fmt: skip
+    assert np.all(gap[1] < gap[0] - 5e-5), gap
 
 
 def test_every_session_starts_with_the_hands_on_the_handle():

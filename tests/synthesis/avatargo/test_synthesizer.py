@@ -53,6 +53,28 @@ def test_step_is_run_and_lost_devices_hold(session):
     assert np.isfinite(batch.local_rot).all() and np.isfinite(batch.root_pos).all()
 
 
+def test_a_lost_device_holds_its_last_pose(session):
+    """While the headset is lost (ticks 10-19, its samples zeroed as a driver reports them),
+    the avatar is the one of a stream whose headset stood still at its tick-9 pose: the
+    last tracked pose is held, not replaced by any other."""
+    truth, sample, stream = session
+    hmd = list(stream.device_names).index("hmd")
+    lost = stream.valid.copy()
+    lost[10:20, hmd] = False
+    zeroed = stream.replace(
+        valid=lost,
+        positions=np.where(lost[..., None], stream.positions, 0.0),
+        quaternions=np.where(lost[..., None], stream.quaternions, quat.IDENTITY),
+    )
+    positions, quaternions = stream.positions.copy(), stream.quaternions.copy()
+    positions[10:20, hmd], quaternions[10:20, hmd] = positions[9, hmd], quaternions[9, hmd]
+    held = stream.replace(positions=positions, quaternions=quaternions)
+    synth = AvatarGo(truth.skeleton, sample)
+    out_lost, out_held = synth.run(zeroed), synth.run(held)
+    np.testing.assert_allclose(out_lost.root_pos, out_held.root_pos, atol=1e-9)
+    np.testing.assert_allclose(out_lost.local_rot, out_held.local_rot, atol=1e-9)
+
+
 def test_unknown_solver_is_refused(session):
     truth, sample, _ = session
     with pytest.raises(SynthesisError, match="solver must be one of"):
