@@ -25,10 +25,13 @@ BODY_INDEX_NONE = 255
 
 @dataclass(frozen=True)
 class DepthFrame:
-    """One Kinect frame: ``depth_mm (H, W)`` uint16, ``body_index (H, W)`` uint8."""
+    """One Kinect frame: ``depth_mm (H, W)`` uint16, ``body_index (H, W)`` uint8 and the
+    ground-truth body-part labels ``parts (H, W)`` uint8 (:mod:`.parts`; 0 where there is no
+    body or no depth reading), aligned pixel for pixel with the depth."""
 
     depth_mm: np.ndarray
     body_index: np.ndarray
+    parts: np.ndarray
 
     @property
     def depth_m(self) -> np.ndarray:
@@ -60,27 +63,33 @@ class KinectDepthCamera:
             noise = self.sensor.noise
         self.noise = noise
 
-    def render_clean(self, scene: BodyScene) -> tuple[np.ndarray, np.ndarray]:
-        """Noise-free ``(H, W)`` float32 depth in metres (0 = no hit, no range limit) and
-        ``(H, W)`` int32 part labels (0 background, > 0 body) of the scene as posed now."""
+    def render_clean(self, scene: BodyScene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Noise-free ``(H, W)`` float32 depth in metres (0 = no hit, no range limit),
+        ``(H, W)`` int32 segment labels (0 background, > 0 body) and ``(H, W)`` uint8 painted
+        labels (the body parts of :func:`~render_cams.kinect.parts.paint_parts`) of the
+        scene as posed now."""
         s = self.sensor
-        return scene.render_depth_and_parts(self.camera_to_world, s.K, s.width, s.height)
+        return scene.render_depth_and_layers(self.camera_to_world, s.K, s.width, s.height)
 
     def capture(self, scene: BodyScene, rng: np.random.Generator) -> DepthFrame:
-        """The depth frame and body-index map the sensor records of ``scene`` as posed now."""
-        depth, parts = self.render_clean(scene)
+        """The depth frame, body-index map and part labels the sensor records of ``scene`` as
+        posed now (paint its parts first for the part labels: :func:`.parts.paint_parts`)."""
+        depth, segments, painted = self.render_clean(scene)
         near, far = self.sensor.range_m
         if self.noise is None:
             measured = np.where((depth >= near) & (depth <= far), depth, np.float32(0.0))
-            body = parts > 0
+            body, parts = segments > 0, painted
         else:
             measured, source = self.noise.apply(depth, self.sensor.K, (near, far), rng)
-            body = parts.ravel()[source] > 0
+            body = segments.ravel()[source] > 0
+            parts = painted.ravel()[source].reshape(painted.shape)
+        valid = body & (measured > 0)
         body_index = np.full(measured.shape, BODY_INDEX_NONE, np.uint8)
-        body_index[body & (measured > 0)] = 0
+        body_index[valid] = 0
+        parts = np.where(valid, parts, np.uint8(0))
         measured *= 1e3  # to millimetres, rounded half up (depth is never negative)
         measured += 0.5
-        return DepthFrame(measured.astype(np.uint16), body_index)
+        return DepthFrame(measured.astype(np.uint16), body_index, parts)
 
 
 def write_png(image: np.ndarray, path: str | Path) -> Path:

@@ -24,6 +24,7 @@ from avatar_models import Motion
 from avatar_models.body import BodyDescription
 from render_cams.device import motion_at_rate, resolve_seed
 from render_cams.kinect.depth import BODY_INDEX_NONE, DepthFrame, KinectDepthCamera
+from render_cams.kinect.parts import paint_parts
 from render_cams.kinect.placement import (
     DEFAULT_HEIGHT_M,
     default_sensor_pose,
@@ -59,15 +60,19 @@ class DepthFrames:
     def __iter__(self) -> Iterator[DepthFrame]:
         rng = np.random.default_rng([self.seed, 1])  # the skeleton noise uses seed itself
         with BodyScene(self.body) as scene:
+            paint_parts(scene)
             for t in range(self.motion.n_frames):
                 scene.update(self.motion, t)
                 yield self.camera.capture(scene, rng)
 
-    def stack(self) -> tuple[np.ndarray, np.ndarray]:
-        """``(T, H, W)`` uint16 depth in millimetres (0: no reading) and ``(T, H, W)`` uint8
-        body-index maps (0: body, 255: no body)."""
+    def stack(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``(T, H, W)`` uint16 depth in millimetres (0: no reading), ``(T, H, W)`` uint8
+        body-index maps (0: body, 255: no body) and ``(T, H, W)`` uint8 body-part labels
+        (:mod:`.parts`, 0: none)."""
         frames = list(self)
-        return np.stack([f.depth_mm for f in frames]), np.stack([f.body_index for f in frames])
+        return tuple(
+            np.stack([getattr(f, k) for f in frames]) for k in DepthFrame.__dataclass_fields__
+        )
 
 
 @dataclass(frozen=True, eq=False)

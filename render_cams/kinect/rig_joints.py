@@ -171,3 +171,56 @@ def _swing_orientations(positions: np.ndarray, rest: np.ndarray, parents) -> np.
     rest_bones = rest[end] - rest[start]
     bones = positions[:, end] - positions[:, start]
     return quat.from_matrix(_shortest_rotation(np.broadcast_to(rest_bones, bones.shape), bones))
+
+
+def rig_joints_from_body17(b17: np.ndarray, rig: Rig) -> tuple[np.ndarray, np.ndarray]:
+    """``(T, J, 3)`` positions and ``(T, J, 4)`` roll-free orientations of ``rig``'s joints
+    from measured body17 positions ``(T, 17, 3)`` alone (a tracker's output; NaN where a
+    joint was not found, and NaN in every joint built from it).
+
+    Mapped joints are the body17 points, spine levels lie on the pelvis-neck line, and every
+    other joint keeps its rest offset from its anchor, scaled by the take's median length of
+    the anchor's reference segment and swung with that segment (torso frame for torso
+    anchors): positions carry no roll, so neither do orientations, which are
+    the swing of each rest bone onto the measured bone for both rigs."""
+    rig_rest = _rest_positions(rig.skeleton)
+    rig_b17 = rig_rest[rig.body17_indices()]
+    names = rig.skeleton.names
+    joint_of_b17 = {v: k for k, v in rig.body17.items()}
+    spine = _spine_fractions(rig)
+    extras = EXTRA_ANCHORS[rig.name]
+    torso = _torso_frames(b17) @ _torso_frames(rig_b17[None])[0].T
+    positions = np.empty((b17.shape[0], len(names), 3))
+    for j, name in enumerate(names):
+        if name in joint_of_b17:
+            positions[:, j] = b17[:, INDEX[joint_of_b17[name]]]
+        elif name in spine:
+            f = spine[name]
+            positions[:, j] = (1 - f) * b17[:, INDEX["pelvis"]] + f * b17[:, INDEX["neck"]]
+        else:
+            b = extras[name]
+            a0, a1 = (INDEX[x] for x in _REFERENCE_SEGMENT[b])
+            rest_bone = rig_b17[a1] - rig_b17[a0]
+            bone = b17[:, a1] - b17[:, a0]
+            with np.errstate(invalid="ignore"):
+                scale = np.nanmedian(np.linalg.norm(bone, axis=-1)) / np.linalg.norm(rest_bone)
+            rot = torso if b in _TORSO_ANCHORS else _shortest_rotation(rest_bone, bone)
+            offset = (rig_rest[j] - rig_b17[INDEX[b]]) * scale
+            positions[:, j] = b17[:, INDEX[b]] + rot @ offset
+    return positions, _swing_orientations(positions, rig_rest, rig.skeleton.parents)
+
+
+def body17_dependencies(rig: Rig) -> list[np.ndarray]:
+    """Per rig joint, the body17 indices :func:`rig_joints_from_body17` builds it from."""
+    joint_of_b17 = {v: k for k, v in rig.body17.items()}
+    spine = _spine_fractions(rig)
+    out = []
+    for name in rig.skeleton.names:
+        if name in joint_of_b17:
+            out.append(np.array([INDEX[joint_of_b17[name]]]))
+        elif name in spine:
+            out.append(np.array([INDEX["pelvis"], INDEX["neck"]]))
+        else:
+            b = EXTRA_ANCHORS[rig.name][name]
+            out.append(np.array(sorted({INDEX[b], *(INDEX[x] for x in _REFERENCE_SEGMENT[b])})))
+    return out

@@ -4,6 +4,7 @@ Layout of ``out_dir``::
 
     depth/000000.png        uint16 depth in millimetres (0 = no reading)
     body_index/000000.png   uint8, 0 = body, 255 = no body
+    parts/000000.png        uint8 ground-truth body parts (:mod:`.parts`), 0 = none
     skeleton/000000.json    joints (world and camera space), orientations, tracking states
     preview.mp4             colour-mapped depth with the skeleton drawn on it
     recording.json          device, K, image size, sensor pose, seed, frame count, fps
@@ -36,7 +37,7 @@ def write_kinect_recording(recording: KinectRecording, out_dir: str | Path) -> d
     (its record plus the preview's file name)."""
     sensor, skeleton = recording.sensor, recording.skeleton
     out = Path(out_dir)
-    for sub in ("depth", "body_index", "skeleton"):
+    for sub in ("depth", "body_index", "parts", "skeleton"):
         (out / sub).mkdir(parents=True, exist_ok=True)
     video_path = out / "preview.mp4"
     video = cv2.VideoWriter(
@@ -49,6 +50,7 @@ def write_kinect_recording(recording: KinectRecording, out_dir: str | Path) -> d
         name = f"{t:06d}"
         write_png(frame.depth_mm, out / "depth" / f"{name}.png")
         write_png(frame.body_index, out / "body_index" / f"{name}.png")
+        write_png(frame.parts, out / "parts" / f"{name}.png")
         (out / "skeleton" / f"{name}.json").write_text(skeleton.to_json(t))
         video.write(_preview(frame.depth_mm, skeleton, t, sensor))
     video.release()

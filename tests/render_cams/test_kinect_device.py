@@ -18,7 +18,7 @@ def test_a_kinect_is_a_device_that_records_depth_body_index_and_skeleton():
     assert isinstance(kinect, Device) and kinect.name == "kinect-v2" and kinect.rate_hz == 30.0
     motion = t_pose(4, fps=30.0)
     recording = kinect.sample(motion, seed=3)
-    depth_mm, body_index = recording.frames.stack()
+    depth_mm, body_index, _ = recording.frames.stack()
     # Kinect V2 depth is 512 x 424 (Microsoft's published depth mode).
     assert depth_mm.shape == (2, 424, 512) and depth_mm.dtype == np.uint16
     assert body_index.shape == (2, 424, 512) and len(recording.frames) == 2

@@ -1,0 +1,38 @@
+"""Weighted mean shift with a Gaussian kernel: the densest mode of a 3D point set.
+
+Shotton et al. (CVPR 2011, section 4, eq. 6) find joint proposals as the modes of the density
+``f(x) = sum_i w_i exp(-||(x - x_i) / b||^2)`` of a part's pixels reprojected into the world,
+by mean shift (Comaniciu and Meer 2002). Every seed climbs to its mode; the mode with the
+highest density wins, and the weight within one bandwidth of it is its confidence.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+ITERATIONS = 12
+"""Mean-shift steps per seed (the modes move by under 1 mm after ~8 on body parts)."""
+
+
+def densest_mode(
+    points: np.ndarray, weights: np.ndarray, bandwidth_m: float, n_seeds: int = 24
+) -> tuple[np.ndarray, float]:
+    """The densest mode ``(3,)`` of ``points (N, 3)`` weighted by ``weights (N,)`` (N >= 1)
+    and the total weight of the points within ``bandwidth_m`` of it.
+
+    Seeds are the ``n_seeds`` heaviest points (ties in input order)."""
+    order = np.argsort(-weights, kind="stable")[:n_seeds]
+    modes = points[order]
+    scale = -1.0 / bandwidth_m**2
+    for _ in range(ITERATIONS):
+        kernel = np.exp(scale * _squared_distances(modes, points)) * weights  # (S, N)
+        modes = kernel @ points / np.maximum(kernel.sum(1, keepdims=True), 1e-300)
+    density = (np.exp(scale * _squared_distances(modes, points)) * weights).sum(1)
+    best = modes[int(np.argmax(density))]
+    near = np.sum((points - best) ** 2, axis=1) <= bandwidth_m**2
+    return best, float(weights[near].sum())
+
+
+def _squared_distances(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``(A, B)`` squared distances between ``a (A, 3)`` and ``b (B, 3)``."""
+    return np.maximum(np.sum(a * a, 1)[:, None] + np.sum(b * b, 1)[None] - 2.0 * a @ b.T, 0.0)

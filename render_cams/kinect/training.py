@@ -1,0 +1,194 @@
+"""Training the body-part tracker on the testbed's own rendered depth (Shotton section 2).
+
+:class:`TrackerTrainingConfig` (a TOML file, e.g. ``models/kinect-tracker.toml``) names
+built-in subjects and activities, frames per clip and sensor yaws about the performer;
+:func:`render_training_frames` renders them with the sensor's depth noise, part labels and
+true body17 joints; :func:`train_tracker` samples body pixels, fits scikit-learn's
+``ExtraTreesClassifier`` (randomised thresholds, as Shotton's forest, section 3.2) on the
+depth features, and learns the proposal constants (push-back depth and confidence
+thresholds) on the same frames. Deterministic for a config and seed.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import tomllib
+from dataclasses import asdict, dataclass, fields
+from pathlib import Path
+
+import numpy as np
+
+from avatar_models.generator import generate, sample_subject
+from avatar_models.rigs import body17_positions
+from render_cams.kinect.depth import KinectDepthCamera
+from render_cams.kinect.features import DepthFeatures, body_depth
+from render_cams.kinect.forest import from_sklearn
+from render_cams.kinect.parts import N_PARTS, paint_parts
+from render_cams.kinect.placement import default_sensor_pose, performer_target
+from render_cams.kinect.sensors import KinectError, get_sensor
+from render_cams.kinect.tracker import BodyPartTracker
+from render_cams.scene import BodyScene
+
+
+@dataclass(frozen=True)
+class TrackerTrainingConfig:
+    """What the tracker is trained on and how (see ``models/kinect-tracker.toml``)."""
+
+    sensor: str = "kinect-v2"
+    seed: int = 0
+    subjects: int = 6
+    activities: tuple[str, ...] = ("walk", "wave", "squat", "box", "lunge", "kick", "balance")
+    seconds: float = 2.0
+    frames_per_clip: int = 3
+    yaw_deg: tuple[float, ...] = (-45.0, 0.0, 45.0)
+    pixels_per_frame: int = 400
+    features: int = 200
+    max_offset_m: float = 0.5
+    trees: int = 3
+    max_depth: int = 18
+    min_samples_leaf: int = 20
+
+    def __post_init__(self) -> None:
+        get_sensor(self.sensor)
+        counts = (self.subjects, self.frames_per_clip, self.pixels_per_frame, self.features)
+        if min(counts) < 1 or self.trees < 1 or self.max_depth < 1 or not self.activities:
+            raise KinectError("tracker training counts must be at least 1")
+
+
+def load_training_config(path: str | Path) -> TrackerTrainingConfig:
+    """The config in TOML file ``path``.
+
+    Raises:
+        KinectError: unreadable file, unknown keys or bad values.
+    """
+    try:
+        data = tomllib.loads(Path(path).read_text())
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        raise KinectError(f"{path}: not a readable TOML file ({exc})") from exc
+    known = {f.name for f in fields(TrackerTrainingConfig)}
+    unknown = set(data) - known
+    if unknown:
+        raise KinectError(f"{path}: unknown keys {sorted(unknown)}; known: {sorted(known)}")
+    for key in ("activities", "yaw_deg"):
+        if key in data:
+            data[key] = tuple(data[key])
+    try:
+        return TrackerTrainingConfig(**data)
+    except (TypeError, ValueError) as exc:
+        raise KinectError(f"{path}: {exc}") from exc
+
+
+def orbit(pose: np.ndarray, centre: np.ndarray, yaw_rad: float) -> np.ndarray:
+    """``pose (4, 4)`` turned by ``yaw_rad`` about the vertical axis through ``centre``."""
+    c, s = np.cos(yaw_rad), np.sin(yaw_rad)
+    turn = np.eye(4)
+    turn[:3, :3] = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
+    turn[:3, 3] = centre - turn[:3, :3] @ centre
+    return turn @ pose
+
+
+def render_views(motion, sensor, poses, rng, noise="default"):
+    """Depth frames of every frame of ``motion`` from each pose in ``poses``; yields
+    ``(frame index, pose, DepthFrame)``."""
+    camera_of = [KinectDepthCamera(sensor, p, noise) for p in poses]
+    with BodyScene(motion.skeleton) as scene:
+        paint_parts(scene)
+        for t in range(motion.n_frames):
+            scene.update(motion, t)
+            for pose, camera in zip(poses, camera_of, strict=True):
+                yield t, pose, camera.capture(scene, rng)
+
+
+def render_training_frames(config: TrackerTrainingConfig, subject_offset: int = 0):
+    """``(frames, poses, joints)``: DepthFrames, their ``(4, 4)`` sensor poses and true
+    body17 joints ``(17, 3)`` world, for every subject, activity, frame and yaw of
+    ``config`` (subjects ``subject_offset ...``: held-out sets use an offset)."""
+    sensor = get_sensor(config.sensor)
+    rng = np.random.default_rng([config.seed, subject_offset])
+    frames, poses, joints = [], [], []
+    for s in range(subject_offset, subject_offset + config.subjects):
+        subject = sample_subject(np.random.default_rng([config.seed, s]))
+        for a, activity in enumerate(config.activities):
+            motion = generate(activity, subject, config.seconds, sensor.rate_hz, seed=s * 97 + a)
+            picks = np.linspace(0, motion.n_frames - 1, config.frames_per_clip).round()
+            clip = motion[picks.astype(int)]
+            front = default_sensor_pose(clip, sensor)
+            centre = performer_target(clip)
+            views = [orbit(front, centre, np.radians(y)) for y in config.yaw_deg]
+            b17 = body17_positions(clip)
+            for t, pose, frame in render_views(clip, sensor, views, rng):
+                frames.append(frame)
+                poses.append(pose)
+                joints.append(b17[t])
+    return frames, poses, joints
+
+
+def data_hash(frames) -> str:
+    """SHA-256 (first 16 hex digits) of the frames' depth and part labels."""
+    digest = hashlib.sha256()
+    for f in frames:
+        digest.update(f.depth_mm.tobytes())
+        digest.update(f.parts.tobytes())
+    return digest.hexdigest()[:16]
+
+
+def train_tracker(config: TrackerTrainingConfig, frames=None) -> BodyPartTracker:
+    """The tracker trained on ``frames`` (default: :func:`render_training_frames`)."""
+    from sklearn.ensemble import ExtraTreesClassifier
+
+    frames, poses, joints = frames or render_training_frames(config)
+    sensor = get_sensor(config.sensor)
+    K = sensor.K
+    rng = np.random.default_rng(config.seed)
+    features = DepthFeatures.sample(config.features, config.max_offset_m, rng)
+    X, y = [], []
+    all_features = np.arange(len(features))
+    for frame in frames:
+        rows, cols = np.nonzero(frame.parts > 0)
+        if rows.size == 0:
+            continue
+        pick = rng.choice(rows.size, min(config.pixels_per_frame, rows.size), replace=False)
+        depth = body_depth(frame.depth_mm, frame.body_index)
+        X.append(features.evaluate(depth, K, rows[pick], cols[pick], all_features[None]))
+        y.append(frame.parts[rows[pick], cols[pick]].astype(int) - 1)
+    model = ExtraTreesClassifier(
+        n_estimators=config.trees,
+        max_depth=config.max_depth,
+        min_samples_leaf=config.min_samples_leaf,
+        max_features="sqrt",
+        random_state=config.seed,
+        n_jobs=1,
+    )
+    model.fit(np.concatenate(X).astype(np.float32), np.concatenate(y))
+    forest = from_sklearn(model, features, N_PARTS)
+    zeros = np.zeros(N_PARTS)
+    draft = BodyPartTracker(forest, zeros, zeros, zeros)
+    push, area = _proposal_statistics(draft, frames, poses, joints, K)
+    meta = {
+        "config": asdict(config),
+        "seed": config.seed,
+        "data_hash": data_hash(frames),
+        "frames": len(frames),
+        "classifier": "sklearn.ensemble.ExtraTreesClassifier",
+    }
+    return BodyPartTracker(
+        forest, push, TRACKED_SHARE * area, INFERRED_SHARE * area, draft.stride, meta=meta
+    )
+
+
+TRACKED_SHARE = 0.25
+"""A joint is Tracked when its part's confidence reaches this share of the training median."""
+INFERRED_SHARE = 0.05
+"""... and Inferred from this share on; below it, no proposal (NotTracked)."""
+
+
+def _proposal_statistics(tracker, frames, poses, joints, K) -> tuple[np.ndarray, np.ndarray]:
+    """Per part: the median depth from surface mode to true joint (``zeta_c``) and the
+    median confidence of the proposals, over the training frames."""
+    pushes, areas = [], []
+    for frame, pose, b17 in zip(frames, poses, joints, strict=True):
+        modes, conf = tracker.propose(frame.depth_mm, frame.body_index, K)
+        truth_z = ((b17 - pose[:3, 3]) @ pose[:3, :3])[:, 2]
+        pushes.append(truth_z - modes[:, 2])
+        areas.append(np.where(conf > 0, conf, np.nan))
+    return np.nan_to_num(np.nanmedian(pushes, 0)), np.nan_to_num(np.nanmedian(areas, 0))
