@@ -1,14 +1,17 @@
-"""``avatarsim eval METHOD --library DIR|builtin --protocol cross-subject|cross-trial``.
+"""``avatarsim eval``: the evaluations, one subcommand each with only its own options.
 
+``eval protocol METHOD --library DIR|builtin --protocol cross-subject|cross-trial``:
 CoolMoves' accuracy protocols (§4.1) with the IK baseline beside: prints the per-class and
 overall tables, writes the contract JSON and Fig. 4-like bar plots into ``--out``.
 ``eval leaderboard`` runs every registered method instead (:mod:`scripts.leaderboard`) and
 writes ``leaderboard.json``, ``.png`` and ``.html`` (each fold's rows saved in ``OUT/folds``:
 a rerun with the same settings resumes; delete it after changing the code); ``eval
-avatargo`` runs AvatarGo's simulated user study, exact against fixed offsets
-(:mod:`scripts.avatargo_eval`), and writes ``avatargo.json`` and ``avatargo.png``. Exit 2 for
-bad input (unknown method or protocol, a folder without clips, cross-subject on clips
-without subject labels).
+avatargo-study`` runs AvatarGo's simulated user study, exact against fixed offsets
+(:mod:`scripts.avatargo_eval`); ``eval movebox-study`` MoveBox's (:mod:`scripts.movebox_eval`);
+``eval controllerpose`` ControllerPose's §5.3 accuracy on a dataset. Exit 2 for bad input
+(unknown method or protocol, a folder without clips, cross-subject on clips without subject
+labels, an option another evaluation has). The old spellings ``eval METHOD``, ``eval
+avatargo`` and ``eval movebox`` run these with a deprecation line (:mod:`scripts.cli_legacy`).
 """
 
 from __future__ import annotations
@@ -253,41 +256,168 @@ def run_movebox(library, out, wanted, per_source, duration, quick, audio, kinect
     console.print(f"wrote {out}/movebox.json and {out}/story/ (story.mp4, story.xml)")
 
 
+# Options shared by several evaluations, each defined once (defaults stay at the commands).
+LibraryOpt = Annotated[
+    str, typer.Option(help="'builtin' (generator) or a mocap folder (Bandai, CMU).")
+]
+ProtocolOpt = Annotated[
+    str, typer.Option(help="cross-subject (leave one subject out) or cross-trial.")
+]
+OutOpt = Annotated[Path, typer.Option(help="Folder for JSON and plots.")]
+ClassesOpt = Annotated[
+    str | None, typer.Option(help="Comma-separated classes (activities/styles) to keep.")
+]
+ClassByOpt = Annotated[
+    str | None, typer.Option(help="activity or style (default: style for Bandai).")
+]
+MaxPerClassOpt = Annotated[
+    int | None, typer.Option(help="At most this many clips per class (subsampling).")
+]
+SubjectsOpt = Annotated[int, typer.Option(help="builtin: subjects per activity.")]
+TakesOpt = Annotated[int, typer.Option(help="builtin: takes per subject and activity.")]
+DurationOpt = Annotated[float, typer.Option(help="builtin: seconds per take.")]
+QuickOpt = Annotated[bool, typer.Option(help="Small inputs, for a smoke run.")]
+
+OLD_NAMES = {"avatargo": "avatargo-study", "movebox": "movebox-study"}
+
+
+def _old_eval(args: list[str], commands) -> tuple[list[str], str] | None:
+    """``eval METHOD ...`` -> ``eval protocol METHOD ...``; ``eval avatargo``/``movebox`` ->
+    ``eval avatargo-study``/``movebox-study``."""
+    from scripts.cli_legacy import is_new_spelling
+
+    if is_new_spelling(args, commands) or args[0].startswith("-"):
+        return None
+    name = args[0]
+    if name in OLD_NAMES:
+        return [OLD_NAMES[name], *args[1:]], f"eval {name}: use eval {OLD_NAMES[name]}"
+    return ["protocol", *args], f"eval {name}: use eval protocol {name}"
+
+
+def _check_ranges(*checks: tuple[str, float, float, float]) -> None:
+    """Each ``(option, value, lo, hi)`` within ``[lo, hi]`` (NaN is not)."""
+    from synthesis.evaluate import EvaluationError
+
+    for option, value, lo, hi in checks:
+        if not lo <= value <= hi:  # also NaN
+            raise EvaluationError(f"{option} must be from {lo:g} to {hi:g}, got {value}")
+
+
+def _check_source(library: str, max_per_class: int | None, duration: float) -> None:
+    """The options every evaluation on motions has: the source, subsampling, take length."""
+    from synthesis.evaluate import EvaluationError
+
+    _check_ranges(
+        ("--duration", duration, 0.5, 600.0),
+        ("--max-per-class", 1 if max_per_class is None else max_per_class, 1, 100_000),
+    )
+    if library != "builtin" and not Path(library).is_dir():
+        raise EvaluationError(f"--library must be 'builtin' or a folder; {library} is not")
+
+
+def _check_protocol(protocol: str) -> None:
+    from synthesis.evaluate import PROTOCOLS, EvaluationError
+
+    if protocol not in PROTOCOLS:
+        raise EvaluationError(f"unknown protocol {protocol!r}; use {' or '.join(PROTOCOLS)}")
+
+
+def _class_list(classes: str | None) -> list[str] | None:
+    return None if classes is None else [c.strip() for c in classes.split(",") if c.strip()]
+
+
+def _trials(
+    library: str,
+    wanted: list[str] | None,
+    class_by: str | None,
+    max_per_class: int | None,
+    subjects: int,
+    takes: int,
+    duration: float,
+    quick: bool,
+    seed: int,
+) -> tuple[list, float]:
+    """The trials to evaluate and the seconds per built-in take (``--quick`` shrinks both)."""
+    from synthesis.evaluate import builtin_trials, library_trials
+
+    _check_ranges(("--subjects", subjects, 1, 50), ("--takes", takes, 1, 20))
+    if quick:
+        subjects, takes, duration = min(subjects, 3), min(takes, 2), min(duration, 3.0)
+        max_per_class = min(max_per_class or 6, 6)
+        wanted = wanted or (["box", "run"] if library == "builtin" else None)
+    if library != "builtin":
+        return library_trials(Path(library), class_by, wanted, max_per_class, seed), duration
+    kwargs = {} if wanted is None else {"activities": wanted}
+    trials = builtin_trials(
+        n_subjects=subjects, n_takes=takes, duration_s=duration, seed=seed, **kwargs
+    )
+    return trials, duration
+
+
+def _progress(bar: Progress, label: str):
+    """A progress callback ``(done, total, label)`` on a new task of ``bar``."""
+    task = bar.add_task(label, total=None)
+
+    def progress(done: int, total: int, label: str) -> None:
+        bar.update(task, completed=done, total=total, description=escape(label))
+
+    return progress
+
+
+def write_protocol(results: dict, out: Path, json_out: Path | None) -> None:
+    """Print a protocol's tables and notes; write its JSON and plots into ``out``."""
+    from synthesis.report_plots import write_plots
+
+    console.print(_table(results))
+    if "ablation_full_cm" in results["overall"]:
+        steps = results["overall"]["ablation_full_cm"]
+        console.print(
+            "ablation (full body, cm): "
+            + " -> ".join(f"{k} {v:.1f}" for k, v in steps.items())
+            + "  (paper cross-subject: 16.5 -> 13.2 -> 11.4)"
+        )
+    for cls, reason in results["skipped"].items():
+        console.print(f"[yellow]skipped[/] {escape(cls)}: {escape(str(reason))}")
+    for fail in results["failed_folds"]:
+        console.print(
+            "[yellow]fold failed[/] "
+            + escape(f"{fail['class']}/{fail['held_out']}: {fail['reason']}")
+        )
+    results["plots"] = write_plots(results, out)
+    emit_json(out / "eval.json", results)
+    emit_json(json_out, results)
+    console.print(f"wrote {out}/eval.json and {', '.join(results['plots'].values())}")
+
+
 def register(app: typer.Typer) -> None:
-    @app.command(name="eval")
+    from scripts.cli_legacy import legacy_group
+
+    group = typer.Typer(
+        cls=legacy_group(_old_eval),
+        no_args_is_help=True,
+        help="Evaluations: a method's accuracy protocols, the leaderboard, the papers' studies.",
+    )
+    app.add_typer(group, name="eval")
+
+    @group.command()
     @user_errors
-    def eval_(
+    def protocol(
         method: Annotated[
             str,
             typer.Argument(
                 help="coolmoves (the paper's), coolmoves+arm-ik, coolmoves-gmm, "
-                "coolmoves-centroid-align, coolmoves-own-hand-align (synthesis.methods), "
-                "leaderboard: every "
-                "registered method on the same test motions, accuracy, physics and latency, "
-                "or avatargo: its simulated user study, exact vs fixed offsets (one user "
-                "per test motion), "
-                "or movebox: MoveBox's retargeting, roll, smoothing, loops, lip sync and story."
+                "coolmoves-centroid-align, coolmoves-own-hand-align (synthesis.methods)."
             ),
         ],
-        library: Annotated[
-            str, typer.Option(help="'builtin' (generator) or a mocap folder (Bandai, CMU).")
-        ] = "builtin",
-        protocol: Annotated[
-            str, typer.Option(help="cross-subject (leave one subject out) or cross-trial.")
-        ] = "cross-subject",
-        out: Annotated[Path, typer.Option(help="Folder for JSON and plots.")] = Path("out/eval"),
-        classes: Annotated[
-            str | None, typer.Option(help="Comma-separated classes (activities/styles) to keep.")
-        ] = None,
-        class_by: Annotated[
-            str | None, typer.Option(help="activity or style (default: style for Bandai).")
-        ] = None,
-        max_per_class: Annotated[
-            int | None, typer.Option(help="At most this many clips per class (subsampling).")
-        ] = None,
-        subjects: Annotated[int, typer.Option(help="builtin: subjects per activity.")] = 5,
-        takes: Annotated[int, typer.Option(help="builtin: takes per subject and activity.")] = 2,
-        duration: Annotated[float, typer.Option(help="builtin: seconds per take.")] = 8.0,
+        library: LibraryOpt = "builtin",
+        protocol: ProtocolOpt = "cross-subject",
+        out: OutOpt = Path("out/eval"),
+        classes: ClassesOpt = None,
+        class_by: ClassByOpt = None,
+        max_per_class: MaxPerClassOpt = None,
+        subjects: SubjectsOpt = 5,
+        takes: TakesOpt = 2,
+        duration: DurationOpt = 8.0,
         ablation: Annotated[bool, typer.Option(help="Also run the ablation variants.")] = True,
         heading: Annotated[
             float, typer.Option(help="Turn each test motion by a random yaw up to this (deg).")
@@ -302,165 +432,40 @@ def register(app: typer.Typer) -> None:
                 "another value goes beyond the paper, -1 keeps every trial)."
             ),
         ] = None,
-        quick: Annotated[bool, typer.Option(help="Small inputs, for a smoke run.")] = False,
-        methods: Annotated[
-            str | None,
-            typer.Option(help="leaderboard: comma-separated methods (default: every ready one)."),
-        ] = None,
-        workers: Annotated[
-            int, typer.Option(help="leaderboard: folds run in this many processes.")
-        ] = 1,
-        audio: Annotated[
-            Path | None,
-            typer.Option(help="movebox: a WAV file or folder for lip sync (the story's voice)."),
-        ] = None,
-        kinect: Annotated[
-            Path | None,
-            typer.Option(help="movebox: a recorded Kinect take folder to retarget and save."),
-        ] = None,
-        model: Annotated[
-            Path | None, typer.Option(help="controllerpose: the run folder of the model.")
-        ] = None,
-        data: Annotated[
-            Path | None, typer.Option(help="controllerpose: the dataset folder (test split).")
-        ] = None,
-        no_vr_model: Annotated[
-            Path | None, typer.Option(help="controllerpose: a --no-vr run, for the ablation.")
-        ] = None,
-        frame_stride: Annotated[
-            int, typer.Option(help="controllerpose: every k-th camera frame.")
-        ] = 3,
-        mocap: Annotated[
-            Path | None, typer.Option(help="controllerpose: also held-out real clips here.")
-        ] = None,
-        solver: Annotated[
-            str,
-            typer.Option(
-                help="avatargo: per-tick IK, analytic (the paper's Unity IK), mink or "
-                "least-squares."
-            ),
-        ] = "analytic",
+        quick: QuickOpt = False,
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
     ) -> None:
-        """Accuracy protocols of a synthesis method, IK baseline beside (CoolMoves §4.1), or
-        ``leaderboard``: every registered method (scripts/leaderboard.py), or
-        ``controllerpose --model RUN --data DIR`` (scripts/controllerpose/evaluation.py)."""
-        from scripts.avatargo_eval import BUILTIN_ACTIVITIES, run_avatargo_eval
-
-        if method == "controllerpose":
-            from scripts.controllerpose.evaluation import evaluate_command
-
-            evaluate_command(model, data, no_vr_model, frame_stride, out, json_out, mocap)
-            return
-        from scripts.leaderboard import run_leaderboard
+        """Accuracy protocols of a synthesis method, IK baseline beside (CoolMoves §4.1)."""
         from synthesis.coolmoves.correlation import CORRELATION_THRESHOLD
-        from synthesis.evaluate import (
-            EVALUABLE,
-            PROTOCOLS,
-            EvaluationError,
-            builtin_trials,
-            library_trials,
-            run_protocol,
-        )
-        from synthesis.methods import METHODS
-        from synthesis.report_plots import write_plots
+        from synthesis.evaluate import EVALUABLE, EvaluationError, run_protocol
 
         if correlation_threshold is None:
             correlation_threshold = CORRELATION_THRESHOLD
-        for option, value, lo, hi in (
-            ("--subjects", subjects, 1, 50),
-            ("--takes", takes, 1, 20),
-            ("--duration", duration, 0.5, 600.0),
+        if method not in EVALUABLE:
+            raise EvaluationError(
+                f"unknown method {method!r}; available: {', '.join(EVALUABLE)} "
+                "(other evaluations: avatarsim eval --help)"
+            )
+        _check_protocol(protocol)
+        _check_source(library, max_per_class, duration)
+        _check_ranges(
             ("--heading", heading, 0.0, 180.0),
             ("--db-headings", db_headings, 1, 36),
             ("--correlation-threshold", correlation_threshold, -1.0, 1.0),
-            ("--max-per-class", 1 if max_per_class is None else max_per_class, 1, 100_000),
-            ("--workers", workers, 1, 256),
-        ):
-            if not lo <= value <= hi:  # also NaN
-                raise EvaluationError(f"{option} must be from {lo:g} to {hi:g}, got {value}")
-        # Every method, MoveBox too: a typo is not silently run as the default.
-        if protocol not in PROTOCOLS:
-            raise EvaluationError(f"unknown protocol {protocol!r}; use {' or '.join(PROTOCOLS)}")
+        )
         check_outputs(json_out=json_out, out=out)
-        board_methods = None if methods is None else [m.strip() for m in methods.split(",")]
-        if board_methods is not None:
-            unknown = [m for m in board_methods if m not in METHODS]
-            if method != "leaderboard" or unknown or not board_methods:
-                raise EvaluationError(
-                    "--methods is for eval leaderboard, a comma-separated list of "
-                    f"{', '.join(METHODS)}; got {methods!r}"
-                )
-        if method == "movebox":
-            keep = None if classes is None else [c.strip() for c in classes.split(",") if c.strip()]
-            run_movebox(
-                library, out, keep, max_per_class, duration, quick, audio, kinect, seed, json_out
-            )
-            return
-        if method not in (*EVALUABLE, "leaderboard", "avatargo"):
-            raise EvaluationError(
-                f"unknown method {method!r}; available: {', '.join(EVALUABLE)}, leaderboard, "
-                "avatargo, movebox"
-            )
-        wanted = None if classes is None else [c.strip() for c in classes.split(",") if c.strip()]
-        if method == "avatargo":
-            from synthesis.avatargo.synthesizer import SOLVERS
-
-            if solver not in SOLVERS:
-                raise EvaluationError(
-                    f"--solver must be one of {', '.join(SOLVERS)}, got {solver!r}"
-                )
-        if method == "avatargo" and wanted is None and library == "builtin":
-            wanted = list(BUILTIN_ACTIVITIES[:1] if quick else BUILTIN_ACTIVITIES)
-        if quick:
-            subjects, takes, duration = min(subjects, 3), min(takes, 2), min(duration, 3.0)
-            max_per_class = min(max_per_class or 6, 6)
-            wanted = wanted or (["box", "run"] if library == "builtin" else None)
-        if library == "builtin":
-            kwargs = {} if wanted is None else {"activities": wanted}
-            trials = builtin_trials(
-                n_subjects=subjects, n_takes=takes, duration_s=duration, seed=seed, **kwargs
-            )
-        else:
-            folder = Path(library)
-            if not folder.is_dir():
-                raise EvaluationError(f"--library must be 'builtin' or a folder; {folder} is not")
-            trials = library_trials(folder, class_by, wanted, max_per_class, seed)
+        trials, _ = _trials(
+            library, _class_list(classes), class_by, max_per_class, subjects, takes, duration,
+            quick, seed,
+        )  # fmt: skip
         with Progress(console=err_console, transient=True) as bar:
-            task = bar.add_task(f"{method} {protocol}", total=None)
-
-            def progress(done: int, total: int, label: str) -> None:
-                bar.update(task, completed=done, total=total, description=escape(label))
-
-            def fold_done(done: int, total: int, label: str) -> None:
-                # A line per fold too: a long leaderboard is often run into a log file.
-                progress(done, total, label)
-                err_console.print(f"fold {done}/{total} done: {escape(label)}")
-
-            if method == "avatargo":
-                results = run_avatargo_eval(trials, duration, progress=progress, solver=solver)
-                results.update(library=library, seed=seed, quick=quick, class_by=class_by)
-                write_avatargo(results, out, json_out)
-                return
-            if method == "leaderboard":
-                board = run_leaderboard(
-                    trials,
-                    protocol,
-                    board_methods,
-                    progress=fold_done,
-                    resume=out / "folds",
-                    workers=workers,
-                )
-                board.update(library=library, seed=seed, quick=quick, class_by=class_by)
-                write_leaderboard(board, out, json_out)
-                return
             results = run_protocol(
                 trials,
                 protocol,
                 method,
                 ablation,
-                progress=progress,
+                progress=_progress(bar, f"{method} {protocol}"),
                 heading_deg=heading,
                 db_headings=db_headings,
                 correlation_threshold=correlation_threshold,
@@ -468,22 +473,177 @@ def register(app: typer.Typer) -> None:
         results.update(
             library=library, seed=seed, quick=quick, class_by=class_by, trials_total=len(trials)
         )
-        console.print(_table(results))
-        if "ablation_full_cm" in results["overall"]:
-            steps = results["overall"]["ablation_full_cm"]
-            console.print(
-                "ablation (full body, cm): "
-                + " -> ".join(f"{k} {v:.1f}" for k, v in steps.items())
-                + "  (paper cross-subject: 16.5 -> 13.2 -> 11.4)"
+        write_protocol(results, out, json_out)
+
+    @group.command()
+    @user_errors
+    def leaderboard(
+        library: LibraryOpt = "builtin",
+        protocol: ProtocolOpt = "cross-subject",
+        out: OutOpt = Path("out/eval"),
+        classes: ClassesOpt = None,
+        class_by: ClassByOpt = None,
+        max_per_class: MaxPerClassOpt = None,
+        subjects: SubjectsOpt = 5,
+        takes: TakesOpt = 2,
+        duration: DurationOpt = 8.0,
+        methods: Annotated[
+            str | None,
+            typer.Option(help="Comma-separated methods (default: every ready one)."),
+        ] = None,
+        workers: Annotated[int, typer.Option(help="Folds run in this many processes.")] = 1,
+        quick: QuickOpt = False,
+        seed: SeedOpt = 0,
+        json_out: JsonOpt = None,
+    ) -> None:
+        """Every registered method on the same test motions: accuracy, physics, latency.
+
+        scripts/leaderboard.py. Each fold's rows are saved in OUT/folds: a rerun with the same
+        settings resumes."""
+        from scripts.leaderboard import run_leaderboard
+        from synthesis.evaluate import EvaluationError
+        from synthesis.methods import METHODS
+
+        board_methods = None if methods is None else [m.strip() for m in methods.split(",")]
+        if board_methods is not None and (
+            not board_methods or any(m not in METHODS for m in board_methods)
+        ):
+            raise EvaluationError(
+                f"--methods takes a comma-separated list of {', '.join(METHODS)}; got {methods!r}"
             )
-        for cls, reason in results["skipped"].items():
-            console.print(f"[yellow]skipped[/] {escape(cls)}: {escape(str(reason))}")
-        for fail in results["failed_folds"]:
-            console.print(
-                "[yellow]fold failed[/] "
-                + escape(f"{fail['class']}/{fail['held_out']}: {fail['reason']}")
+        _check_protocol(protocol)
+        _check_source(library, max_per_class, duration)
+        _check_ranges(("--workers", workers, 1, 256))
+        check_outputs(json_out=json_out, out=out)
+        trials, _ = _trials(
+            library, _class_list(classes), class_by, max_per_class, subjects, takes, duration,
+            quick, seed,
+        )  # fmt: skip
+        with Progress(console=err_console, transient=True) as bar:
+            progress = _progress(bar, f"leaderboard {protocol}")
+
+            def fold_done(done: int, total: int, label: str) -> None:
+                # A line per fold too: a long leaderboard is often run into a log file.
+                progress(done, total, label)
+                err_console.print(f"fold {done}/{total} done: {escape(label)}")
+
+            board = run_leaderboard(
+                trials,
+                protocol,
+                board_methods,
+                progress=fold_done,
+                resume=out / "folds",
+                workers=workers,
             )
-        results["plots"] = write_plots(results, out)
-        emit_json(out / "eval.json", results)
-        emit_json(json_out, results)
-        console.print(f"wrote {out}/eval.json and {', '.join(results['plots'].values())}")
+        board.update(library=library, seed=seed, quick=quick, class_by=class_by)
+        write_leaderboard(board, out, json_out)
+
+    @group.command(name="avatargo-study")
+    @user_errors
+    def avatargo_study(
+        library: LibraryOpt = "builtin",
+        out: OutOpt = Path("out/eval"),
+        classes: ClassesOpt = None,
+        class_by: ClassByOpt = None,
+        max_per_class: MaxPerClassOpt = None,
+        subjects: SubjectsOpt = 5,
+        takes: TakesOpt = 2,
+        duration: DurationOpt = 8.0,
+        solver: Annotated[
+            str,
+            typer.Option(
+                help="Per-tick IK: analytic (the paper's Unity IK), mink or least-squares."
+            ),
+        ] = "analytic",
+        quick: QuickOpt = False,
+        seed: SeedOpt = 0,
+        json_out: JsonOpt = None,
+    ) -> None:
+        """AvatarGo's simulated user study: exact against fixed offsets.
+
+        One user per test motion (scripts/avatargo_eval.py); writes avatargo.json and
+        avatargo.png."""
+        from scripts.avatargo_eval import BUILTIN_ACTIVITIES, run_avatargo_eval
+        from synthesis.avatargo.synthesizer import SOLVERS
+        from synthesis.evaluate import EvaluationError
+
+        if solver not in SOLVERS:
+            raise EvaluationError(f"--solver must be one of {', '.join(SOLVERS)}, got {solver!r}")
+        _check_source(library, max_per_class, duration)
+        check_outputs(json_out=json_out, out=out)
+        wanted = _class_list(classes)
+        if wanted is None and library == "builtin":
+            wanted = list(BUILTIN_ACTIVITIES[:1] if quick else BUILTIN_ACTIVITIES)
+        trials, duration = _trials(
+            library, wanted, class_by, max_per_class, subjects, takes, duration, quick, seed
+        )
+        with Progress(console=err_console, transient=True) as bar:
+            results = run_avatargo_eval(
+                trials, duration, progress=_progress(bar, "avatargo"), solver=solver
+            )
+        results.update(library=library, seed=seed, quick=quick, class_by=class_by)
+        write_avatargo(results, out, json_out)
+
+    @group.command(name="movebox-study")
+    @user_errors
+    def movebox_study(
+        library: LibraryOpt = "builtin",
+        out: OutOpt = Path("out/eval"),
+        classes: ClassesOpt = None,
+        max_per_class: Annotated[
+            int | None, typer.Option(help="A mocap folder: at most this many takes per source.")
+        ] = None,
+        duration: Annotated[float, typer.Option(help="Seconds per take.")] = 8.0,
+        audio: Annotated[
+            Path | None,
+            typer.Option(help="A WAV file or folder for lip sync (the story's voice)."),
+        ] = None,
+        kinect: Annotated[
+            Path | None,
+            typer.Option(help="A recorded Kinect take folder to retarget and save."),
+        ] = None,
+        quick: QuickOpt = False,
+        seed: SeedOpt = 0,
+        json_out: JsonOpt = None,
+    ) -> None:
+        """MoveBox's retargeting, roll, smoothing, loops, lip sync and story.
+
+        scripts/movebox_eval.py; writes movebox.json and story/."""
+        _check_source(library, max_per_class, duration)
+        check_outputs(json_out=json_out, out=out)
+        run_movebox(
+            library, out, _class_list(classes), max_per_class, duration, quick, audio, kinect,
+            seed, json_out,
+        )  # fmt: skip
+
+    @group.command()
+    @user_errors
+    def controllerpose(
+        model: Annotated[
+            Path, typer.Option(exists=True, help="The run folder (or checkpoint) of the model.")
+        ],
+        data: Annotated[
+            Path,
+            typer.Option(exists=True, file_okay=False, help="The dataset folder (its test split)."),
+        ],
+        no_vr_model: Annotated[
+            Path | None,
+            typer.Option(exists=True, help="A model trained with --no-vr, for the ablation."),
+        ] = None,
+        frame_stride: Annotated[int, typer.Option(help="Every k-th camera frame.")] = 3,
+        mocap: Annotated[
+            Path | None,
+            typer.Option(exists=True, file_okay=False, help="Also held-out real clips (BVH) here."),
+        ] = None,
+        out: OutOpt = Path("out/eval"),
+        seed: Annotated[
+            int, typer.Option("--seed", help="Seed of the devices rendering --mocap clips.")
+        ] = 0,
+        json_out: JsonOpt = None,
+    ) -> None:
+        """ControllerPose §5.3 accuracy on a dataset's held-out split and on real mocap.
+
+        scripts/controllerpose/evaluation.py; writes eval.json and per_joint.png."""
+        from scripts.controllerpose.evaluation import evaluate_command
+
+        evaluate_command(model, data, no_vr_model, frame_stride, out, json_out, mocap, seed)

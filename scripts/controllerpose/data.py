@@ -128,6 +128,18 @@ def split_streams(root: Path, split: str) -> dict[int, tuple[TrackingStream, flo
     return {group: sample_stream(sample) for group, sample in split_samples(root, split)}
 
 
+def mocap_files(folder: Path) -> list[Path]:
+    """The BVH files of ``folder``'s tree, sorted.
+
+    Raises:
+        DatasetError: the folder has no BVH file.
+    """
+    files = sorted(Path(folder).rglob("*.bvh"))
+    if not files:
+        raise DatasetError(f"{folder}: no .bvh clip to evaluate on")
+    return files
+
+
 def mocap_examples(
     folder: Path, clips: int, seconds: float, seed: int = 0
 ) -> tuple[Examples, dict[int, tuple[TrackingStream, float]]]:
@@ -146,9 +158,7 @@ def mocap_examples(
     from scripts.stages.devices import REALISTIC_NOISE
     from sim.humanoid import humanoid_for
 
-    files = sorted(Path(folder).rglob("*.bvh"))
-    if not files:
-        raise DatasetError(f"{folder}: no .bvh clip to evaluate on")
+    files = mocap_files(folder)
     picked = [files[i] for i in np.linspace(0, len(files) - 1, min(clips, len(files))).astype(int)]
     setup = VRSetup(devices=HEADSET_AND_CONTROLLERS, noise=REALISTIC_NOISE)
     parts, streams = [], {}

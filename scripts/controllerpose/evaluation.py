@@ -23,7 +23,7 @@ from avatar_models.body17 import BODY17
 from avatar_models.errors import AvatarsimError
 from avatar_models.fileio import write_json
 from scripts.controllerpose.coolmoves_baseline import coolmoves_positions, training_motions
-from scripts.controllerpose.data import load_examples, mocap_examples, split_streams
+from scripts.controllerpose.data import load_examples, mocap_examples, mocap_files, split_streams
 from scripts.controllerpose.figures import plt, save_png
 from synthesis.controllerpose.checkpoint import Checkpoint, load
 from synthesis.controllerpose.evaluate import (
@@ -95,6 +95,7 @@ def run_evaluation(
     frame_stride: int,
     mocap: Path | None = None,
     mocap_clips: int = 4,
+    seed: int = 0,
 ) -> dict[str, Any]:
     """Evaluates (module docstring), writes ``out/eval.json`` and ``out/per_joint.png``."""
     checkpoint = load(model)
@@ -112,7 +113,7 @@ def run_evaluation(
     )
     real = None
     if mocap is not None:
-        clips, streams = mocap_examples(mocap, mocap_clips, MOCAP_SECONDS)
+        clips, streams = mocap_examples(mocap, mocap_clips, MOCAP_SECONDS, seed)
         clips.features.check_finite(f"{mocap} clips")
         clips = clips.take(np.arange(0, len(clips), frame_stride))
         real = split_results(
@@ -136,6 +137,7 @@ def run_evaluation(
         ),
         "real_mocap": real,
         "real_mocap_folder": None if mocap is None else str(mocap),
+        "seed": seed,
         "paper": PAPER,
     }
     out.mkdir(parents=True, exist_ok=True)
@@ -152,6 +154,7 @@ def evaluate_command(
     out: Path,
     json_out: Path | None,
     mocap: Path | None = None,
+    seed: int = 0,
 ) -> None:
     """``avatarsim eval controllerpose``: checks the options, evaluates, prints a table."""
     from rich.table import Table
@@ -162,8 +165,10 @@ def evaluate_command(
         raise EvaluationError("eval controllerpose needs --model RUN and --data DIR")
     if frame_stride < 1:
         raise EvaluationError(f"--frame-stride must be at least 1, got {frame_stride}")
+    if mocap is not None:
+        mocap_files(mocap)
     check_outputs(json_out=json_out, out=out)
-    report = run_evaluation(model, data, out, no_vr_model, frame_stride, mocap)
+    report = run_evaluation(model, data, out, no_vr_model, frame_stride, mocap, seed=seed)
     table = Table(title=f"ControllerPose, §5.3 normalised, test: {report['split']}")
     for column in ("test", "method", "mean cm (SD)", "without hip+torso cm (SD)", "frames"):
         table.add_column(column)

@@ -1,4 +1,4 @@
-"""``avatarsim eval avatargo``: the simulated user study on built-in motion (CLI, JSON, plot)
+"""``avatarsim eval avatargo-study``: the simulated user study on built-in motion (CLI, JSON, plot)
 and on one real clip of each mocap source (CMU, Bandai dataset-1 and dataset-2)."""
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ def test_eval_avatargo_builtin_writes_json_and_plot(tmp_path):
     out, js = tmp_path / "out", tmp_path / "r.json"
     result = runner.invoke(
         app,
-        ["eval", "avatargo", "--quick", "--subjects", "1", "--takes", "1", "--duration",
+        ["eval", "avatargo-study", "--quick", "--subjects", "1", "--takes", "1", "--duration",
          "0.5", "--out", str(out), "--json", str(js)],
     )  # fmt: skip
     assert result.exit_code == 0, result.output
@@ -59,7 +59,7 @@ def test_eval_avatargo_on_a_real_clip(mocap_dir: Path, source):
 
 def test_eval_avatargo_refuses_an_unknown_solver(tmp_path):
     result = runner.invoke(
-        app, ["eval", "avatargo", "--quick", "--solver", "unity", "--out", str(tmp_path)]
+        app, ["eval", "avatargo-study", "--quick", "--solver", "unity", "--out", str(tmp_path)]
     )
     assert result.exit_code == 2
     assert "--solver must be one of analytic, mink, least-squares" in result.output

@@ -61,8 +61,8 @@ def commands_with(kind: str, target: str, scenario: Path) -> list[list[str]]:
         return [
             ["check", "builtin:walk", "--out", target],
             ["control", "builtin:walk", "--out", target],
-            ["render", "builtin:walk", "--out", target],
-            ["eval", "coolmoves", "--out", target],
+            ["render", "fisheye", "builtin:walk", "--out", target],
+            ["eval", "protocol", "coolmoves", "--out", target],
             ["run", str(scenario), "--out", target],
             ["demo", "--out", target],
             ["convert", "builtin:walk", str(Path(target) / "x.bvh")],
@@ -72,8 +72,8 @@ def commands_with(kind: str, target: str, scenario: Path) -> list[list[str]]:
         ["convert", "builtin:walk", str(Path(target).parent / "ok.bvh"), "--json", target],
         ["check", "builtin:walk", "--json", target],
         ["control", "builtin:walk", "--json", target],
-        ["render", "builtin:walk", "--json", target],
-        ["eval", "coolmoves", "--json", target],
+        ["render", "fisheye", "builtin:walk", "--json", target],
+        ["eval", "protocol", "coolmoves", "--json", target],
         ["run", str(scenario), "--json", target],
         ["demo", "--json", target],
         ["bench", "--json", target],
@@ -223,11 +223,15 @@ def test_absurd_numbers_exit_2(tmp_path, clip):
     bad(["convert", str(clip), str(tmp_path / "x.bvh"), "--fps", "nan"], "--fps")
     bad(["control", str(clip), "--seconds", "inf", "--out", out], "--seconds", "at most 600")
     bad(["control", str(clip), "--samples", "100000", "--out", out], "--samples")
-    bad(["render", str(clip), "--duration-s", "inf", "--out", out], "--duration-s")
-    bad(["render", str(clip), "--size", "40000,30000", "--out", out], "--size", "16-4096")
-    bad(["render", str(clip), "--fov", "nan,90", "--out", out], "--fov")
-    bad(["eval", "coolmoves", "--duration", "inf", "--out", out], "--duration")
-    bad(["eval", "coolmoves", "--correlation-threshold", "nan", "--out", out], "-1 to 1")
+    bad(["render", "fisheye", str(clip), "--duration-s", "inf", "--out", out], "--duration-s")
+    bad(
+        ["render", "fisheye", str(clip), "--size", "40000,30000", "--out", out], "--size", "16-4096"
+    )
+    bad(["render", "fisheye", str(clip), "--fov", "nan,90", "--out", out], "--fov")
+    bad(["eval", "protocol", "coolmoves", "--duration", "inf", "--out", out], "--duration")
+    bad(
+        ["eval", "protocol", "coolmoves", "--correlation-threshold", "nan", "--out", out], "-1 to 1"
+    )
     assert not (tmp_path / "o").exists() and not (tmp_path / "x.bvh").exists()
 
 
@@ -322,10 +326,13 @@ def test_amc_without_asf_gives_advice_a_user_can_follow(tmp_path):
 
 def test_options_that_would_be_ignored_exit_2(tmp_path):
     out = str(tmp_path / "o")
-    bad(
-        ["render", "builtin:walk", "--device", "kinect-v2", "--fov", "90,60", "--out", out], "--fov"
-    )
-    bad(["render", "builtin:walk", "--device", "azure-kinect", "--size", "64,64"], "--size")
+    for device, option, value in (
+        ("kinect-v2", "--fov", "90,60"),
+        ("azure-kinect", "--size", "8,8"),
+    ):
+        result = runner.invoke(app, ["render", device, "builtin:walk", option, value, "--out", out])
+        assert result.exit_code == 2 and f"No such option: {option}" in result.output
+        assert not Path(out).exists()
     bad(["info", "builtin:walk", "--unit", "mm"], "--unit", "builtin:walk")
     sc = tmp_path / "s.toml"
     sc.write_text('[motion]\nunit = "cm"\n')

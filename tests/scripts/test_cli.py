@@ -34,8 +34,8 @@ def test_the_registered_commands_are_enumerated():
         "demo",
         "run",
         "check",
-        "eval",
-        "render",
+        "eval protocol",
+        "render fisheye",
         "bench",
         "control",
     } <= names

@@ -17,7 +17,7 @@ def test_eval_builtin_writes_contract_json_and_plots(tmp_path):
     out, js = tmp_path / "out", tmp_path / "r.json"
     result = runner.invoke(
         app,
-        ["eval", "coolmoves", "--library", "builtin", "--classes", "box", *SMALL,
+        ["eval", "protocol", "coolmoves", "--library", "builtin", "--classes", "box", *SMALL,
          "--heading", "30", "--out", str(out), "--json", str(js)],
     )  # fmt: skip
     assert result.exit_code == 0, result.output
@@ -36,12 +36,16 @@ def test_eval_builtin_writes_contract_json_and_plots(tmp_path):
 @pytest.mark.parametrize(
     ("args", "reason"),
     [
-        (["eval", "magic"], "unknown method"),
-        (["eval", "coolmoves", "--protocol", "cross-galaxy"], "unknown protocol"),
-        (["eval", "movebox", "--protocol", "nonsense"], "unknown protocol"),
-        (["eval", "coolmoves", "--library", "/no/such/folder"], "not"),
+        (["eval", "protocol", "magic"], "unknown method"),
+        (["eval", "protocol", "coolmoves", "--protocol", "cross-galaxy"], "unknown protocol"),
+        (["eval", "movebox-study", "--protocol", "nonsense"], "No such option: --protocol"),
+        (["eval", "protocol", "coolmoves", "--library", "/no/such/folder"], "not"),
         (["eval", "leaderboard", "--methods", "ik,magic"], "--methods"),
-        (["eval", "coolmoves", "--methods", "ik"], "--methods"),
+        (["eval", "protocol", "coolmoves", "--methods", "ik"], "No such option: --methods"),
+        (["eval", "protocol", "coolmoves", "--solver", "x"], "No such option: --solver"),
+        (["eval", "avatargo-study", "--audio", "x"], "No such option: --audio"),
+        (["eval", "movebox-study", "--model", "x"], "No such option: --model"),
+        (["eval", "controllerpose", "--model", "/no/run", "--data", "/no/ds"], "does not exist"),
         (["eval", "leaderboard", "--workers", "0"], "--workers"),
     ],
 )
@@ -52,7 +56,7 @@ def test_bad_input_exits_2_with_a_reason(args, reason):
 
 
 def test_folder_without_clips_exits_2(tmp_path):
-    result = runner.invoke(app, ["eval", "coolmoves", "--library", str(tmp_path)])
+    result = runner.invoke(app, ["eval", "protocol", "coolmoves", "--library", str(tmp_path)])
     assert result.exit_code == 2 and "no motion clips" in result.output
 
 
@@ -60,7 +64,22 @@ def test_folder_without_clips_exits_2(tmp_path):
 def test_bandai_cross_subject_says_why_it_is_impossible(mocap_dir):
     folder = mocap_dir / "bandai" / "dataset-2"
     result = runner.invoke(
-        app, ["eval", "coolmoves", "--library", str(folder), "--classes", "normal",
+        app, ["eval", "protocol", "coolmoves", "--library", str(folder), "--classes", "normal",
               "--max-per-class", "2", "--protocol", "cross-subject"],
     )  # fmt: skip
     assert result.exit_code == 2 and "subject labels" in result.output
+
+
+@pytest.mark.parametrize(
+    ("old", "new"),
+    [
+        ("coolmoves", "protocol coolmoves"),
+        ("avatargo", "avatargo-study"),
+        ("movebox", "movebox-study"),
+    ],
+)
+def test_old_spellings_run_todays_command_with_a_deprecation_line(old, new):
+    result = runner.invoke(app, ["eval", old, "--help"])
+    assert result.exit_code == 0, result.output
+    assert f"use eval {new}" in result.stderr
+    assert f"eval {new.split()[0]} [OPTIONS]" in result.stdout  # the help of today's command

@@ -1,4 +1,4 @@
-"""``avatarsim eval movebox``: the numbers, the story and a recorded take on built-in motion,
+"""``avatarsim eval movebox-study``: the numbers, the story and a recorded take on built-in motion,
 a real clip of each mocap source, and exit 2 for bad input before any work."""
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ def recorded_stream():
 def test_builtin_numbers_story_and_recorded_take(tmp_path, recorded_stream):
     take = write_skeleton_recording(recorded_stream, tmp_path / "take")
     out, js = tmp_path / "out", tmp_path / "r.json"
-    args = ["eval", "movebox", "--quick", "--classes", "walk", "--duration", "1.5",
+    args = ["eval", "movebox-study", "--quick", "--classes", "walk", "--duration", "1.5",
             "--kinect", str(take), "--out", str(out), "--json", str(js)]  # fmt: skip
     if (AUDIO_DIR / "hello.wav").is_file():
         args += ["--audio", str(AUDIO_DIR / "hello.wav")]
@@ -89,7 +89,7 @@ def test_real_clip_of_each_source(tmp_path, mocap_dir):
     out, js = tmp_path / "out", tmp_path / "r.json"
     result = runner.invoke(
         app,
-        ["eval", "movebox", "--library", str(mocap_dir), "--quick", "--duration", "1.0",
+        ["eval", "movebox-study", "--library", str(mocap_dir), "--quick", "--duration", "1.0",
          "--out", str(out), "--json", str(js)],
     )  # fmt: skip
     assert result.exit_code == 0, result.output
@@ -110,7 +110,7 @@ def test_real_clip_of_each_source(tmp_path, mocap_dir):
 
 @pytest.mark.parametrize("case", ["audio", "empty", "never-tracked", "not-a-recording"])
 def test_bad_input_exits_2_before_work(tmp_path, recorded_stream, case):
-    args = ["eval", "movebox", "--out", str(tmp_path / "out")]
+    args = ["eval", "movebox-study", "--out", str(tmp_path / "out")]
     if case == "audio":
         bad = tmp_path / "voice.mp3"
         bad.write_bytes(b"ID3\x03 an mp3, not a wav")

@@ -86,7 +86,7 @@ def _invoke(command: str, motion: str, tmp: Path) -> tuple[int, str]:
         scenario.write_text(SCENARIO.format(source=tmp.name, path=source, builtin=builtin))
         args = ["run", str(scenario), "--out", str(tmp / "out"), "--json", str(js)]
     else:
-        args = ["render", motion, "--device", command, "--duration-s", "0.3"]
+        args = ["render", command, motion, "--duration-s", "0.3"]
         args += ["--out", str(tmp / "out"), "--json", str(js)]
     result = runner.invoke(app, args)
     return result.exit_code, result.output

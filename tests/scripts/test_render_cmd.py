@@ -1,4 +1,4 @@
-"""``avatarsim render``: files a device would record, and exit 2 for bad input."""
+"""``avatarsim render DEVICE``: files a device would record, and exit 2 for bad input."""
 
 from __future__ import annotations
 
@@ -22,9 +22,8 @@ def test_kinect_render_writes_depth_in_millimetres(tmp_path):
         app,
         [
             "render",
-            "builtin:wave",
-            "--device",
             "kinect-v2",
+            "builtin:wave",
             "--out",
             str(out),
             "--duration-s",
@@ -51,7 +50,7 @@ def test_kinect_render_writes_depth_in_millimetres(tmp_path):
 
 def test_sensor_pose_and_frame_range_options(tmp_path):
     out = tmp_path / "k"
-    args = ["render", "builtin:walk", "--device", "azure-kinect", "--out", str(out)]
+    args = ["render", "azure-kinect", "builtin:walk", "--out", str(out)]
     result = runner.invoke(
         app,
         [
@@ -74,49 +73,76 @@ def test_sensor_pose_and_frame_range_options(tmp_path):
     np.testing.assert_allclose(pose[:3, 2], [-1.0, 0.0, 0.0], atol=1e-9)
     fish = runner.invoke(
         app,
-        ["render", "builtin:walk", "--out", str(tmp_path / "f"), "--size", "64,48",
+        ["render", "fisheye", "builtin:walk", "--out", str(tmp_path / "f"), "--size", "64,48",
          "--end", "0.1", "--ring-offset", "0.03,0,0.05", "--grip-pitch", "-40"],
     )  # fmt: skip
     assert fish.exit_code == 0, fish.output
 
 
-def test_options_of_another_device_and_bad_ranges_exit_2(tmp_path):
+def test_options_of_another_device_exit_2_as_unknown(tmp_path):
+    for device, extra in (
+        ("kinect-v2", ["--fov", "150,120"]),
+        ("azure-kinect", ["--ring-offset", "0,0,0.1"]),
+        ("fisheye", ["--sensor-pos", "2,0,1"]),
+    ):
+        result = runner.invoke(
+            app, ["render", device, "builtin:walk", "--out", str(tmp_path), *extra]
+        )
+        assert result.exit_code == 2, (device, result.output)
+        assert f"No such option: {extra[0]}" in result.output
+    assert not any(tmp_path.iterdir())
+
+
+def test_bad_ranges_and_placements_exit_2(tmp_path):
     cases = [
-        (["--device", "kinect-v2", "--fov", "150,120"], "--fov only apply to --device fisheye"),
-        (["--device", "azure-kinect", "--ring-offset", "0,0,0.1"], "--ring-offset only apply"),
-        (["--sensor-pos", "2,0,1"], "only apply to a Kinect device"),
-        (["--device", "kinect-v2", "--sensor-yaw", "90"], "need --sensor-pos"),
-        (["--device", "kinect-v2", "--sensor-pos", "2,0"], "three numbers"),
+        ("kinect-v2", ["--sensor-yaw", "90"], "need --sensor-pos"),
+        ("kinect-v2", ["--sensor-pos", "2,0"], "three numbers"),
+        ("kinect-v2", ["--sensor-pos", "2,0,1", "--sensor-height", "1"], "not both"),
         (
-            [
-                "--device",
-                "kinect-v2",
-                "--sensor-pos",
-                "2,0,1",
-                "--sensor-look-at",
-                "0,0,1",
-                "--sensor-pitch",
-                "3",
-            ],
+            "kinect-v2",
+            ["--sensor-pos", "2,0,1", "--sensor-look-at", "0,0,1", "--sensor-pitch", "3"],
             "not both",
-        ),  # fmt: skip
-        (["--device", "kinect-v2", "--sensor-pos", "2,0,-1"], "below the floor"),
-        (["--end", "1", "--duration-s", "1"], "not both"),
-        (["--start", "1", "--end", "0.5"], "after --start"),
-        (["--end", "soon"], "seconds or 'end'"),
-        (["--ring-offset", "0.5,0,0"], "within"),
+        ),
+        ("kinect-v2", ["--sensor-pos", "2,0,-1"], "below the floor"),
+        ("fisheye", ["--end", "1", "--duration-s", "1"], "not both"),
+        ("azure-kinect", ["--start", "1", "--end", "0.5"], "after --start"),
+        ("fisheye", ["--end", "soon"], "seconds or 'end'"),
+        ("fisheye", ["--ring-offset", "0.5,0,0"], "within"),
     ]
-    for extra, message in cases:
-        result = runner.invoke(app, ["render", "builtin:walk", "--out", str(tmp_path), *extra])
+    for device, extra, message in cases:
+        args = ["render", device, "builtin:walk", "--out", str(tmp_path), *extra]
+        result = runner.invoke(app, args)
         assert result.exit_code == 2, (extra, result.output)
         assert message in result.stderr, (extra, result.stderr)
 
 
+def test_the_old_spelling_renders_the_same_with_a_deprecation_line(tmp_path):
+    """``render MOTION --device D`` runs ``render D MOTION``: the same files, byte for byte."""
+    common = ["--duration-s", "0.1", "--size", "32,24", "--seed", "4"]
+    old = runner.invoke(
+        app,
+        ["render", "builtin:wave", "--device", "fisheye", "--out", str(tmp_path / "old"), *common],
+    )
+    new = runner.invoke(
+        app, ["render", "fisheye", "builtin:wave", "--out", str(tmp_path / "new"), *common]
+    )
+    assert old.exit_code == 0 and new.exit_code == 0, old.output + new.output
+    assert "deprecated: render MOTION --device fisheye: use render fisheye MOTION" in old.stderr
+    assert "deprecated" not in new.stderr
+    files = sorted(p.relative_to(tmp_path / "new") for p in (tmp_path / "new").rglob("*.png"))
+    assert files
+    for name in files:
+        assert (tmp_path / "old" / name).read_bytes() == (tmp_path / "new" / name).read_bytes()
+    default = runner.invoke(app, ["render", "builtin:wave", "--out", str(tmp_path / "d"), *common])
+    assert default.exit_code == 0 and "use render fisheye MOTION" in default.stderr
+
+
 def test_frame_range_past_a_file_clip_exits_2(tmp_path):
     clip = save_motion(generate("walk", duration_s=1.0, seed=0), tmp_path / "walk.npz")
-    late = runner.invoke(app, ["render", str(clip), "--start", "5", "--out", str(tmp_path / "o")])
+    render = ["render", "fisheye", str(clip), "--out", str(tmp_path / "o")]
+    late = runner.invoke(app, [*render, "--start", "5"])
     assert late.exit_code == 2 and "past the clip's end" in late.stderr
-    long = runner.invoke(app, ["render", str(clip), "--end", "3", "--out", str(tmp_path / "o")])
+    long = runner.invoke(app, [*render, "--end", "3"])
     assert long.exit_code == 2 and "--end end" in long.stderr
 
 
@@ -124,18 +150,18 @@ def test_unknown_device_and_activity_exit_2(tmp_path):
     bad = runner.invoke(
         app, ["render", "builtin:walk", "--device", "lidar", "--out", str(tmp_path)]
     )
-    assert bad.exit_code == 2 and "unknown device" in bad.stderr
-    bad = runner.invoke(app, ["render", "builtin:fly", "--out", str(tmp_path)])
+    assert bad.exit_code == 2 and "No such command 'lidar'" in bad.output
+    bad = runner.invoke(app, ["render", "fisheye", "builtin:fly", "--out", str(tmp_path)])
     assert bad.exit_code == 2 and "unknown built-in activity" in bad.stderr
 
 
 def test_impossible_fisheye_intrinsics_exit_2(tmp_path):
     wide = runner.invoke(
-        app, ["render", "builtin:walk", "--fov", "200,120", "--out", str(tmp_path)]
+        app, ["render", "fisheye", "builtin:walk", "--fov", "200,120", "--out", str(tmp_path)]
     )
     assert wide.exit_code == 2 and "FOV" in wide.stderr
     garbled = runner.invoke(
-        app, ["render", "builtin:walk", "--size", "640", "--out", str(tmp_path)]
+        app, ["render", "fisheye", "builtin:walk", "--size", "640", "--out", str(tmp_path)]
     )
     assert garbled.exit_code == 2 and "--size takes two numbers" in garbled.stderr
     assert not any(tmp_path.iterdir())  # nothing written for bad input
