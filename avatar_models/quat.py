@@ -164,9 +164,13 @@ def unit_to_matrix(q: np.ndarray) -> np.ndarray:
 
     :func:`to_matrix` for the hot path: no normalisation (the input must be unit) and no
     ``Rotation`` set-up; one outer product and one matrix product (:func:`_quadratic_forms`),
-    a handful of numpy calls whatever the batch shape."""
+    a handful of numpy calls whatever the batch shape. The product is stacked, one
+    ``(1, 16) @ (16, 9)`` per quaternion, so that each matrix is the same whatever the batch:
+    a single ``(N, 16) @ (16, 9)`` goes to a BLAS kernel that sums in an order which depends
+    on ``N`` (OpenBLAS's AVX-512 kernels do), and a synthesiser's ``step`` (a batch of one)
+    would then differ from its ``run`` in the last bit."""
     q = np.asarray(q, float)
-    outer = (q[..., :, None] * q[..., None, :]).reshape(*q.shape[:-1], 16)
+    outer = (q[..., :, None] * q[..., None, :]).reshape(*q.shape[:-1], 1, 16)
     return (outer @ _FORMS).reshape(*q.shape[:-1], 3, 3)
 
 

@@ -83,3 +83,19 @@ def test_numpy_euler_matches_scipy(order):
     np.testing.assert_allclose(quat.unit_to_matrix(q)[:, 0], rots.as_matrix(), atol=1e-12)
     back = quat.from_euler(quat.to_euler(q, axes), axes)[:, 0]
     np.testing.assert_allclose(np.abs(np.sum(back * q[:, 0], axis=-1)), 1.0, atol=1e-12)
+
+
+def test_conversions_do_not_depend_on_the_batch():
+    """A quaternion's matrix and Euler angles are the same bits alone as in a batch: a
+    synthesiser's ``step`` (a batch of one) must equal its ``run`` (OpenBLAS's AVX-512 GEMM
+    sums a ``(N, 16) @ (16, 9)`` product in an order that depends on ``N``)."""
+    q = np.random.default_rng(3).normal(size=(20, 4))
+    q /= np.linalg.norm(q, axis=-1, keepdims=True)
+    axes = quat.euler_axes("YXZ")
+    alone = np.stack([quat.unit_to_matrix(q[i : i + 1])[0] for i in range(len(q))])
+    assert np.array_equal(quat.unit_to_matrix(q), alone)
+    euler = quat.to_euler(q[:, None], axes)
+    alone = np.stack([quat.to_euler(q[i : i + 1, None], axes)[0] for i in range(len(q))])
+    assert np.array_equal(euler, alone)
+    back = np.stack([quat.from_euler(euler[i : i + 1], axes)[0] for i in range(len(q))])
+    assert np.array_equal(quat.from_euler(euler, axes), back)
