@@ -60,7 +60,7 @@ test: lint
 	$(BIN)/python -m pytest -q -n 2 --dist loadfile
 
 bench: $(STAMP)
-	$(BIN)/avatarsim bench
+	$(BIN)/avatarsim bench $(if $(wildcard ../shared/mocap),--mocap ../shared/mocap)
 
 clean:
 	rm -rf $(VENV) out .pytest_cache .hypothesis

@@ -19,6 +19,7 @@ from rich.table import Table
 
 import scripts.commands
 from avatar_models.errors import AvatarsimError
+from avatar_models.mocap_dir import MOCAP_ENV, mocap_dir
 from scripts.cli_common import (
     JsonOpt,
     SeedOpt,
@@ -204,6 +205,13 @@ def bench(
     quick: Annotated[bool, typer.Option(help="Smaller inputs, for a smoke run.")] = False,
     seed: SeedOpt = 0,
     json_out: JsonOpt = None,
+    mocap: Annotated[
+        Path | None,
+        typer.Option(
+            help="Real-mocap folder (cmu/, bandai/) for the benchmarks that read real clips; "
+            f"default ${MOCAP_ENV}, else generated motion."
+        ),
+    ] = None,
 ) -> None:
     """Benchmarks: prints a table, writes JSON (name, unit, value, baseline, ratio)."""
     from scripts.benchmarks import BENCHMARKS, run_benchmark
@@ -216,7 +224,8 @@ def bench(
         raise AvatarsimError(
             f"unknown benchmark {unknown[0]!r}; available: {', '.join(BENCHMARKS)}"
         )
-    rows = [row for n in names for row in run_benchmark(n, quick=quick)]
+    mocap = mocap_dir(mocap)
+    rows = [row for n in names for row in run_benchmark(n, quick=quick, mocap=mocap)]
     table = Table(title="avatarsim bench")
     for col in ("name", "unit", "value", "baseline", "ratio"):
         table.add_column(col, justify="right" if col != "name" else "left")
@@ -226,7 +235,11 @@ def bench(
         table.add_row(escape(r.name), r.unit, f"{r.value:.4g}", base, ratio)
     console.print(table)
     # Benchmark inputs are fixed (seeded inside each module); the seed is recorded as asked.
-    payload = {"seed": seed, "benchmarks": [r.to_json() for r in rows]}
+    payload = {
+        "seed": seed,
+        "mocap": None if mocap is None else str(mocap),
+        "benchmarks": [r.to_json() for r in rows],
+    }
     emit_json(json_out, payload)
 
 

@@ -10,6 +10,7 @@ import importlib
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
+from pathlib import Path
 
 # name -> module under scripts.benchmarks; a new benchmark is a new module plus a line here.
 BENCHMARKS: dict[str, str] = {
@@ -59,8 +60,10 @@ def best_of(fn: Callable[[], object], repeat: int = 3) -> float:
     return best
 
 
-def run_benchmark(name: str, quick: bool = False) -> list[BenchRow]:
+def run_benchmark(name: str, quick: bool = False, mocap: Path | None = None) -> list[BenchRow]:
+    """Rows of benchmark ``name``; ``mocap`` is the real-mocap folder for the benchmarks that
+    read real clips (:func:`avatar_models.mocap_dir.mocap_dir`; None: generated motion)."""
     if name not in BENCHMARKS:
         raise KeyError(name)
     module = importlib.import_module(f"scripts.benchmarks.{BENCHMARKS[name]}")
-    return module.run(quick=quick)
+    return module.run(quick=quick, mocap=mocap)

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import os
 from contextlib import contextmanager
+from pathlib import Path
 
 import numpy as np
 from threadpoolctl import threadpool_limits
@@ -61,7 +62,7 @@ def one_core():
             os.sched_setaffinity(0, cpus)
 
 
-def run(quick: bool = False) -> list[BenchRow]:
+def run(quick: bool = False, mocap: Path | None = None) -> list[BenchRow]:
     truth = generate("wave", sample_subject(np.random.default_rng(0)), 2.0 if quick else 4.0)
     user = sample_user(0, truth.skeleton)
     setup = setup_for(user, REALISTIC_NOISE)

@@ -7,6 +7,8 @@ body17-frames/s of keypoint projection; the baseline column is the sensor's real
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import cv2
 import numpy as np
 
@@ -47,7 +49,7 @@ RENDER_CONFIGS = (
 )
 
 
-def run(quick: bool = False) -> list[BenchRow]:
+def run(quick: bool = False, mocap: Path | None = None) -> list[BenchRow]:
     cv2.setNumThreads(1)  # "per camera on one core"
     motion = generate("box", duration_s=1.0, fps=30)
     poses = camera_poses(motion, controller_cameras())

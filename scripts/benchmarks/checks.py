@@ -9,6 +9,8 @@ residual force (``mj_inverse`` per frame). Baseline: 90 frames/s, so the ratio r
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from avatar_models.generator import generate
 from scripts.benchmarks import BenchRow, best_of
 from sim.checks import ALL_CHECKS
@@ -19,7 +21,7 @@ from sim.replay import replay_kinematic
 REAL_TIME_HZ = 90.0
 
 
-def run(quick: bool = False) -> list[BenchRow]:
+def run(quick: bool = False, mocap: Path | None = None) -> list[BenchRow]:
     motion = generate("walk", duration_s=10.0 if quick else 60.0, fps=REAL_TIME_HZ)
     h = humanoid_for(motion)
     body, model, qpos = h.body, h.model, h.qpos

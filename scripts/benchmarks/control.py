@@ -8,8 +8,8 @@ judged 0.2 s later), next to real time (1x); the share of 10 s built-in walks (s
 followed without a fall by the search, next to the plain controller's share (not in
 ``--quick``); retargeting frames/s (``sim.retarget``: body17 IK with mink, stance feet levelled for
 control, as :func:`sim.humanoid.humanoid_for` does for a foreign rig) on a Bandai walk from
-``../shared/mocap`` (the built-in walk when that folder is absent), next to the clip's own
-frame rate.
+the mocap folder (``bench --mocap`` or ``$AVATARSIM_MOCAP``; the built-in walk without one),
+next to the clip's own frame rate.
 """
 
 from __future__ import annotations
@@ -25,7 +25,6 @@ from sim.control.search import search
 from sim.humanoid import humanoid_for
 from sim.retarget import retarget
 
-MOCAP_DIR = Path(__file__).resolve().parents[2].parent / "shared" / "mocap"
 RETARGET_CLIP = "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh"
 
 
@@ -66,9 +65,9 @@ def _upright_row() -> BenchRow:
     )
 
 
-def _retarget_row(quick: bool) -> BenchRow:
-    path = MOCAP_DIR / RETARGET_CLIP
-    real = path.is_file()
+def _retarget_row(quick: bool, mocap: Path | None) -> BenchRow:
+    path = None if mocap is None else mocap / RETARGET_CLIP
+    real = path is not None and path.is_file()
     motion = load_motion(path) if real else generate("walk", duration_s=2.0)
     motion = motion[: 60 if quick else motion.n_frames]
     t0 = time.perf_counter()
@@ -84,6 +83,6 @@ def _retarget_row(quick: bool) -> BenchRow:
     )
 
 
-def run(quick: bool = False) -> list[BenchRow]:
+def run(quick: bool = False, mocap: Path | None = None) -> list[BenchRow]:
     """Control and retargeting rows; see the module docstring."""
-    return [*_speed_rows(quick), *([] if quick else [_upright_row()]), _retarget_row(quick)]
+    return [*_speed_rows(quick), *([] if quick else [_upright_row()]), _retarget_row(quick, mocap)]

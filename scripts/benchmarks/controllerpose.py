@@ -16,6 +16,8 @@ size: the weights do not change the time. One torch thread.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import cv2
 import numpy as np
 import torch
@@ -61,7 +63,7 @@ def compositing_s(uv: np.ndarray, conf: np.ndarray, repeat: int) -> float:
     return best_of(composite_and_warp, repeat)
 
 
-def run(quick: bool = False) -> list[BenchRow]:
+def run(quick: bool = False, mocap: Path | None = None) -> list[BenchRow]:
     """Per-stage rows; see the module docstring."""
     torch.set_num_threads(1)
     motion = generate("walk", duration_s=1.0 if quick else 3.0, fps=30.0, seed=0)

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import os
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -47,7 +48,7 @@ def _step_times(synth, stream, quick: bool) -> tuple[np.ndarray, np.ndarray]:
     return passes[0][0], np.stack([cpu for _, cpu in passes])
 
 
-def run(quick: bool = False) -> list[BenchRow]:
+def run(quick: bool = False, mocap: Path | None = None) -> list[BenchRow]:
     rng = np.random.default_rng(0)
     n_train = 2 if quick else 4
     subjects = [sample_subject(rng) for _ in range(n_train + 1)]

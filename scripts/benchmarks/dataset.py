@@ -85,7 +85,7 @@ def _ray_rows(config: DatasetConfig, folder: Path) -> list[BenchRow]:
     return [BenchRow("dataset_ray[2 vs 1 workers]", "samples/s", two, one, "1 worker", note)]
 
 
-def run(quick: bool = False) -> list[BenchRow]:
+def run(quick: bool = False, mocap: Path | None = None) -> list[BenchRow]:
     """The rows of the module docstring."""
     seconds = 1.0 if quick else 4.0
     subjects = 1 if quick else 2

@@ -3,7 +3,7 @@
 Rows: BVH parse throughput in MB/s (our ``read_bvh``, which also builds the ``Motion``, vs
 ``bvhio.readAsBvh``) and forward kinematics in (frames x joints)/s (``Motion.global_positions``
 vs bvhio's ``loadPose`` + ``PositionWorld`` per frame). Files: a CMU and a Bandai clip from
-``../shared/mocap``; a generated clip when that folder is absent.
+the mocap folder (``bench --mocap`` or ``$AVATARSIM_MOCAP``); a generated clip without one.
 """
 
 from __future__ import annotations
@@ -15,7 +15,6 @@ from avatar_models.formats.bvh import read_bvh, write_bvh
 from avatar_models.generator import generate
 from scripts.benchmarks import BenchRow, best_of
 
-MOCAP_DIR = Path(__file__).resolve().parents[2].parent / "shared" / "mocap"
 REAL_CLIPS = ("cmu/125_01.bvh", "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh")
 
 
@@ -71,13 +70,11 @@ def _rows_for(path: Path, label: str, quick: bool) -> list[BenchRow]:
     return rows
 
 
-def run(quick: bool = False) -> list[BenchRow]:
+def run(quick: bool = False, mocap: Path | None = None) -> list[BenchRow]:
     """Parse and FK rows per clip; see the module docstring."""
-    if MOCAP_DIR.is_dir():
+    if mocap is not None:
         return [
-            row
-            for clip in REAL_CLIPS
-            for row in _rows_for(MOCAP_DIR / clip, clip.split("/")[0], quick)
+            row for clip in REAL_CLIPS for row in _rows_for(mocap / clip, clip.split("/")[0], quick)
         ]
     with tempfile.TemporaryDirectory() as tmp:
         return _rows_for(_generated_clip(Path(tmp)), "generated", quick)

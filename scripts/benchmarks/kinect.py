@@ -6,6 +6,8 @@ NFOV (640 x 576), and skeleton frames/s (joints, tracking state, noise) on a 10 
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from avatar_models.generator import generate
@@ -18,7 +20,7 @@ from scripts.benchmarks import BenchRow, best_of
 _SENSOR_RATE = "sensor's own rate"
 
 
-def run(quick: bool = False) -> list[BenchRow]:
+def run(quick: bool = False, mocap: Path | None = None) -> list[BenchRow]:
     """Depth and skeleton rows; see the module docstring."""
     motion = generate("box", duration_s=2.0 if quick else 10.0, fps=30.0, seed=0)
     pose = default_sensor_pose(motion)

@@ -8,6 +8,8 @@ between (smoothing only); baseline: the IK baseline's median step.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from avatar_models.generator import generate
@@ -22,7 +24,7 @@ from synthesis.scoring import step_latencies_ms
 SENSORS = ("kinect-v2", "azure-kinect")
 
 
-def run(quick: bool = False) -> list[BenchRow]:
+def run(quick: bool = False, mocap: Path | None = None) -> list[BenchRow]:
     truth = generate("box", duration_s=2.0 if quick else 8.0, fps=90.0, seed=0)
     stream = VRSetup().sample(truth, seed=0)
     baseline = float(

@@ -14,6 +14,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 
 from avatar_models.generator import generate
@@ -191,5 +193,5 @@ def pipeline_rows(quick: bool) -> list[BenchRow]:
     ]
 
 
-def run(quick: bool = False) -> list[BenchRow]:
+def run(quick: bool = False, mocap: Path | None = None) -> list[BenchRow]:
     return filter_rows(quick) + detector_rows(quick) + composite_rows(quick) + pipeline_rows(quick)

@@ -32,7 +32,7 @@ def _timed(entries, workers: int) -> tuple[float, float]:
     return wall, stages
 
 
-def run(quick: bool = False) -> list[BenchRow]:
+def run(quick: bool = False, mocap: Path | None = None) -> list[BenchRow]:
     paths = [SMOKE / f for f in QUICK] if quick else [SMOKE]
     entries = load_suite(paths)
     n = len(entries)
