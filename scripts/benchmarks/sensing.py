@@ -19,7 +19,7 @@ import numpy as np
 from avatar_models.generator import generate
 from avatar_models.rigs import body17_positions
 from render_cams.fisheye import bad_frames
-from render_cams.fisheye.detector import KeypointDetector
+from render_cams.fisheye.detector import ErrorModelDetector
 from render_cams.fisheye.device import FisheyeRig
 from render_cams.fisheye.keypoints import confidence, project_joints
 from render_cams.fisheye.model import FisheyeModel
@@ -81,7 +81,7 @@ def detector_rows(quick: bool) -> list[BenchRow]:
     """Keypoint error of the detector model on projected keypoints (no rendering: visibility
     is 'in the image'), three activities, both controllers."""
     model = FisheyeModel.from_fov()
-    detector = KeypointDetector()
+    detector = ErrorModelDetector()
     rng = np.random.default_rng(0)
     per_camera, on_composite, in_torso, missed, swapped, sizes = [], [], [], [], [], []
     cameras = controller_cameras()
@@ -94,7 +94,7 @@ def detector_rows(quick: bool) -> list[BenchRow]:
         )
         uv, in_image = uv.reshape(n, c, 17, 2), in_image.reshape(n, c, 17)
         score = confidence(model, uv, in_image)
-        detection = detector.detect(uv, in_image, in_image, score, rng)
+        detection = detector.detect_projected(uv, in_image, in_image, score, rng)
         per_camera.append(_errors(detection, uv))
         sizes.append(detection.scale_px[detection.scale_px > 0])
         missed.append(1.0 - detection.detected[in_image].mean())
