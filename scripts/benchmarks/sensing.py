@@ -7,6 +7,9 @@
   paper's 640 x 480, per camera, on the composite and in the torso-normal view, with its miss
   and swap shares;
 - the composite's coverage (185 x 150 deg, baseline: the former 130 deg-wide composite);
+- the real 2D detector (MediaPipe BlazePose, standing in for OpenPose v1.7) on the rendered
+  raw camera images, composites, torso-normal views and a third-person control view
+  (:mod:`scripts.benchmarks.pose_detection`);
 - time per recorded frame (four cameras) with the filter, detector and composite views, against
   the same rig without the detector (the exact keypoints the records held before), and the
   stitch time per composite against the 130 deg-wide one.
@@ -28,7 +31,7 @@ from render_cams.fisheye.render import FisheyeRenderer
 from render_cams.fisheye.rig import camera_poses, controller_cameras
 from render_cams.fisheye.stitch import stitch_params
 from render_cams.scene import BodyScene
-from scripts.benchmarks import BenchRow, best_of
+from scripts.benchmarks import BenchRow, best_of, pose_detection
 
 FORMER_HALF_WIDTH_DEG = 65.0  # the composite before the 150 deg one
 SEEDS = range(6)
@@ -192,4 +195,10 @@ def pipeline_rows(quick: bool) -> list[BenchRow]:
 
 
 def run(quick: bool = False) -> list[BenchRow]:
-    return filter_rows(quick) + detector_rows(quick) + composite_rows(quick) + pipeline_rows(quick)
+    return (
+        filter_rows(quick)
+        + detector_rows(quick)
+        + composite_rows(quick)
+        + pipeline_rows(quick)
+        + pose_detection.run(quick)
+    )
