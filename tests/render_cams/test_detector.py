@@ -8,6 +8,7 @@ from scipy.stats import spearmanr
 from avatar_models.body17 import BODY17, INDEX
 from render_cams.device import DeviceError
 from render_cams.fisheye.detector import BODY17_SIGMAS, ErrorModelDetector
+from render_cams.fisheye.pose_detector import ViewTruth
 
 N = 20000
 # A person whose keypoints span a 200 x 400 px box: person size sqrt(200 * 400) px.
@@ -93,3 +94,27 @@ def test_no_person_below_four_joints_and_nothing_out_of_the_image():
 def test_bad_parameters_are_rejected(bad):
     with pytest.raises(DeviceError, match="detector model"):
         ErrorModelDetector(**bad)
+
+
+def test_protocol_detect_reports_one_image_as_the_batched_model_does():
+    """The ``"error-model"`` PoseDetector on one image is the batched model on its exact
+    keypoints (same draws), finds no person with 3 joints in the image, and reads no pixel:
+    a black and a white image give the same report."""
+    detector = ErrorModelDetector()
+    uv = person(1)[0]
+    in_image = np.ones(17, bool)
+    truth = ViewTruth(uv, in_image, in_image, np.ones(17))
+    black, white = np.zeros((480, 640, 3), np.uint8), np.full((480, 640, 3), 255, np.uint8)
+    one = detector.detect(black, truth, np.random.default_rng(4))
+    batched = detector.detect_projected(
+        uv, in_image, in_image, np.ones(17), np.random.default_rng(4)
+    )
+    np.testing.assert_array_equal(one.uv, batched.uv)
+    np.testing.assert_array_equal(one.confidence, batched.confidence)
+    assert one.person and one.detector == "error-model"
+    again = detector.detect(white, truth, np.random.default_rng(4))
+    np.testing.assert_array_equal(again.uv, one.uv)
+    few = np.zeros(17, bool)
+    few[:3] = True
+    nobody = detector.detect(black, ViewTruth(uv, few, few, np.ones(17)), np.random.default_rng(4))
+    assert not nobody.person and not nobody.detected.any()
