@@ -42,6 +42,7 @@ from avatar_models.body17 import BODY17
 from avatar_models.formats import load_motion
 from avatar_models.generator import generate
 from avatar_models.rigs import body17_positions
+from render_cams.device import motion_at_rate
 from render_cams.fisheye.blazepose import BlazePoseDetector
 from render_cams.fisheye.detector import MIN_PERSON_JOINTS, ErrorModelDetector
 from render_cams.fisheye.device import FisheyeRig
@@ -80,7 +81,7 @@ def clip_motion(source: str, start_s: float, duration_s: float) -> Motion | None
             return None
         motion = load_motion(path)
     first = int(round(start_s * motion.fps))
-    return motion[first : first + int(round(duration_s * motion.fps))]
+    return motion_at_rate(motion[first : first + int(round(duration_s * motion.fps))], CAMERA_FPS)
 
 
 class Scores:
