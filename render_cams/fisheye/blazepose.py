@@ -82,12 +82,20 @@ BODY17_FROM_BLAZEPOSE: dict[str, tuple[int, ...]] = {
         if name not in ("head", "neck", "pelvis")
     },
 }
-# (17, 33) averaging matrix: body17 pixels = M @ landmark pixels.
-LANDMARK_WEIGHTS = np.zeros((len(BODY17), 33))
-for _k, _name in enumerate(BODY17):
-    LANDMARK_WEIGHTS[_k, list(BODY17_FROM_BLAZEPOSE[_name])] = 1.0 / len(
-        BODY17_FROM_BLAZEPOSE[_name]
-    )
+N_LANDMARKS = 33
+
+
+def landmark_weights() -> np.ndarray:
+    """``(17, 33)`` averaging matrix of :data:`BODY17_FROM_BLAZEPOSE`: body17 pixels are it
+    times the landmark pixels."""
+    weights = np.zeros((len(BODY17), N_LANDMARKS))
+    for k, name in enumerate(BODY17):
+        marks = list(BODY17_FROM_BLAZEPOSE[name])
+        weights[k, marks] = 1.0 / len(marks)
+    return weights
+
+
+LANDMARK_WEIGHTS = landmark_weights()
 
 
 def load_pose_solution() -> Any:
