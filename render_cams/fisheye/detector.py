@@ -1,5 +1,10 @@
-"""A 2D keypoint detector's errors, as a statistical model (ControllerPose §4.3 runs OpenPose on
-the composites; here the exact projections are turned into what such a detector reports).
+"""The ``"error-model"`` detector: a 2D keypoint detector's errors as a statistical model, a fast
+approximation from ground truth (ControllerPose §4.3 runs OpenPose on the composites; here the
+exact projections are turned into what such a detector reports, and the pixels are not read).
+:class:`ErrorModelDetector` implements the :class:`~render_cams.fisheye.pose_detector.
+PoseDetector` protocol (:meth:`ErrorModelDetector.detect`, one image) beside its batched
+:meth:`ErrorModelDetector.detect_projected`; the real detector on the pixels is
+:class:`render_cams.fisheye.blazepose.BlazePoseDetector`.
 
 Per frame, vectorised over any leading axes (frames, cameras), for ``body17`` keypoints:
 
@@ -39,11 +44,13 @@ Per frame, vectorised over any leading axes (frames, cameras), for ``body17`` ke
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
 from avatar_models.body17 import BODY17, INDEX
 from render_cams.device import DeviceError
+from render_cams.fisheye.pose_detector import Keypoints2D, ViewTruth, check_image
 
 # COCO keypoint OKS sigmas (cocoapi, pycocotools/cocoeval.py) by COCO keypoint name, plus
 # the mean of COCO-WholeBody's left and right big toe (0.068, 0.092).
@@ -121,8 +128,9 @@ class Detection:
 
 
 @dataclass(frozen=True)
-class KeypointDetector:
-    """The error model of a 2D keypoint detector (module docstring).
+class ErrorModelDetector:
+    """The ``"error-model"`` detector: the error model of a 2D keypoint detector, a fast
+    approximation from the exact projections (module docstring).
 
     Attributes:
         error_scale: localisation error over COCO's annotator error (per axis, times
@@ -134,6 +142,7 @@ class KeypointDetector:
         confidence_noise: standard deviation of the confidence's log-normal noise.
     """
 
+    name: ClassVar[str] = "error-model"
     error_scale: float = 1.5
     occluded_scale: float = 2.0
     miss_rate: float = 0.5
@@ -152,7 +161,16 @@ class KeypointDetector:
         sigma = self.error_scale * BODY17_SIGMAS * np.asarray(scale_px)[..., None]
         return np.where(visible, sigma, self.occluded_scale * sigma)
 
-    def detect(
+    def detect(self, image: np.ndarray, truth: ViewTruth, rng: np.random.Generator) -> Keypoints2D:
+        """The :class:`~render_cams.fisheye.pose_detector.PoseDetector` protocol: what the
+        model reports for one image whose exact keypoints are ``truth`` (the pixels of
+        ``image`` ``(H, W, 3)`` uint8 are checked, not read)."""
+        check_image(image)
+        d = self.detect_projected(truth.uv, truth.in_image, truth.visible, truth.score, rng)
+        person = bool(np.sum(truth.in_image) >= MIN_PERSON_JOINTS)
+        return Keypoints2D(d.uv, d.confidence, d.detected, person, self.name)
+
+    def detect_projected(
         self,
         uv: np.ndarray,
         in_image: np.ndarray,

@@ -8,7 +8,7 @@ each pixel's ray, and one self-describing record per camera frame
 (a camera inside or against the body records a dark frame, :mod:`render_cams.fisheye.occlusion`).
 Then, as the real pipeline does (§4.2-4.3), an image-only filter drops unusable frames
 (:func:`render_cams.fisheye.bad_frames.detect`, on the pixels, not on the injection flag) and a
-2D keypoint detector (:class:`render_cams.fisheye.detector.KeypointDetector`, on by default)
+2D keypoint detector (:class:`render_cams.fisheye.detector.ErrorModelDetector`, on by default)
 reports keypoints on the frames that pass. Records keep the exact projections
 (``keypoints_px``, for re-projection) next to what the detector reported (``detected_px``).
 :func:`render_cams.fisheye.sequence.write_fisheye_recording` writes a recording to a folder.
@@ -31,7 +31,7 @@ from avatar_models.body import BodyDescription
 from avatar_models.rigs import body17_positions
 from render_cams.device import DeviceError, check_rate, motion_at_rate, resolve_seed
 from render_cams.fisheye import bad_frames, occlusion
-from render_cams.fisheye.detector import KeypointDetector
+from render_cams.fisheye.detector import ErrorModelDetector
 from render_cams.fisheye.keypoints import (
     confidence,
     joint_thickness,
@@ -101,7 +101,8 @@ class FisheyeRig:
         scale: image size factor in :data:`SCALE_RANGE`, for quick looks.
         rate_hz: frame rate of every camera.
         bad_frame_rate: share of frames corrupted (interference, sync loss).
-        detector: the 2D keypoint detector's error model (None: report exact projections).
+        detector: the ``"error-model"`` detector, a fast approximation on the exact
+            projections (None: report exact projections).
         controllers: controllers that carry cameras (two each, ring and grip).
         mount: where the cameras sit on a controller (default :class:`Mount`).
     """
@@ -110,7 +111,7 @@ class FisheyeRig:
     scale: float = 1.0
     rate_hz: float = CAMERA_RATE_HZ
     bad_frame_rate: float = bad_frames.BAD_FRAME_RATE
-    detector: KeypointDetector | None = KeypointDetector()
+    detector: ErrorModelDetector | None = ErrorModelDetector()
     controllers: Sequence[str] = ("left_controller", "right_controller")
     mount: Mount | None = None
     name: str = "fisheye"
@@ -200,7 +201,7 @@ class FisheyeRig:
             detected = reported
             detected_px, detected_conf = np.where(detected[..., None], uv, 0.0), score * detected
         else:
-            detection = self.detector.detect(uv, reported, vis, score, rng_noise)
+            detection = self.detector.detect_projected(uv, reported, vis, score, rng_noise)
             detected_px, detected, detected_conf = (
                 detection.uv,
                 detection.detected,
@@ -253,7 +254,9 @@ class FisheyeRig:
             "bad_frames": bad_frames.precision_recall(truth[clear], filtered[clear]),
             "filtered_frames": {name: int(filtered[c].sum()) for c, name in enumerate(names)},
             "occluded_frames": {name: int(occluded[c].sum()) for c, name in enumerate(names)},
-            "detector": None if self.detector is None else asdict(self.detector),
+            "detector": None
+            if self.detector is None
+            else {"name": self.detector.name, **asdict(self.detector)},
             "composites": {
                 controller: {
                     "frames_with_person": int(v.composite_detection.detected.any(axis=1).sum()),

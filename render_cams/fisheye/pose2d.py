@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from render_cams.fisheye.detector import Detection, KeypointDetector
+from render_cams.fisheye.detector import Detection, ErrorModelDetector
 from render_cams.fisheye.model import FisheyeModel
 from render_cams.fisheye.rig import ControllerCamera, camera_pairs
 from render_cams.fisheye.stitch import StitchParams, stitch_params
@@ -106,20 +106,20 @@ def composite_keypoints(
 
 def controller_pose2d(
     params: StitchParams,
-    detector: KeypointDetector,
+    detector: ErrorModelDetector,
     composite: CompositeKeypoints,
     rng: np.random.Generator,
 ) -> ControllerPose2D:
     """Detect on the composite, build the torso-normal views from the reported torso
     corners, detect again there (module docstring)."""
-    detection = detector.detect(
+    detection = detector.detect_projected(
         composite.uv, composite.in_image, composite.visible, composite.score, rng
     )
     view = torso_view(detection.uv, detection.detected)
     torso_uv = apply_homography(view.H, np.nan_to_num(composite.uv))
     cyl = params.cylinder
     in_view = view.valid[:, None] & composite.in_image & inside(torso_uv, cyl.width, cyl.height)
-    again = detector.detect(torso_uv, in_view, composite.visible, composite.score, rng)
+    again = detector.detect_projected(torso_uv, in_view, composite.visible, composite.score, rng)
     return ControllerPose2D(params, composite, detection, view, torso_uv, again)
 
 
@@ -131,7 +131,7 @@ def controller_views(
     visible: np.ndarray,
     score: np.ndarray,
     usable: np.ndarray,
-    detector: KeypointDetector,
+    detector: ErrorModelDetector,
     rng: np.random.Generator,
 ) -> dict[str, ControllerPose2D]:
     """:func:`controller_pose2d` of every controller with two of ``cameras`` (lens

@@ -7,6 +7,9 @@
   paper's 640 x 480, per camera, on the composite and in the torso-normal view, with its miss
   and swap shares;
 - the composite's coverage (185 x 150 deg, baseline: the former 130 deg-wide composite);
+- the real 2D detector (MediaPipe BlazePose, standing in for OpenPose v1.7) on the rendered
+  raw camera images, composites, torso-normal views and a third-person control view
+  (:mod:`scripts.benchmarks.pose_detection`);
 - time per recorded frame (four cameras) with the filter, detector and composite views, against
   the same rig without the detector (the exact keypoints the records held before), and the
   stitch time per composite against the 130 deg-wide one.
@@ -21,7 +24,7 @@ import numpy as np
 from avatar_models.generator import generate
 from avatar_models.rigs import body17_positions
 from render_cams.fisheye import bad_frames
-from render_cams.fisheye.detector import KeypointDetector
+from render_cams.fisheye.detector import ErrorModelDetector
 from render_cams.fisheye.device import FisheyeRig
 from render_cams.fisheye.keypoints import confidence, project_joints
 from render_cams.fisheye.model import FisheyeModel
@@ -30,7 +33,7 @@ from render_cams.fisheye.render import FisheyeRenderer
 from render_cams.fisheye.rig import camera_poses, controller_cameras
 from render_cams.fisheye.stitch import stitch_params
 from render_cams.scene import BodyScene
-from scripts.benchmarks import BenchRow, best_of
+from scripts.benchmarks import BenchRow, best_of, pose_detection
 
 FORMER_HALF_WIDTH_DEG = 65.0  # the composite before the 150 deg one
 SEEDS = range(6)
@@ -83,7 +86,7 @@ def detector_rows(quick: bool) -> list[BenchRow]:
     """Keypoint error of the detector model on projected keypoints (no rendering: visibility
     is 'in the image'), three activities, both controllers."""
     model = FisheyeModel.from_fov()
-    detector = KeypointDetector()
+    detector = ErrorModelDetector()
     rng = np.random.default_rng(0)
     per_camera, on_composite, in_torso, missed, swapped, sizes = [], [], [], [], [], []
     cameras = controller_cameras()
@@ -96,7 +99,7 @@ def detector_rows(quick: bool) -> list[BenchRow]:
         )
         uv, in_image = uv.reshape(n, c, 17, 2), in_image.reshape(n, c, 17)
         score = confidence(model, uv, in_image)
-        detection = detector.detect(uv, in_image, in_image, score, rng)
+        detection = detector.detect_projected(uv, in_image, in_image, score, rng)
         per_camera.append(_errors(detection, uv))
         sizes.append(detection.scale_px[detection.scale_px > 0])
         missed.append(1.0 - detection.detected[in_image].mean())
@@ -194,4 +197,10 @@ def pipeline_rows(quick: bool) -> list[BenchRow]:
 
 
 def run(quick: bool = False, mocap: Path | None = None) -> list[BenchRow]:
-    return filter_rows(quick) + detector_rows(quick) + composite_rows(quick) + pipeline_rows(quick)
+    return (
+        filter_rows(quick)
+        + detector_rows(quick)
+        + composite_rows(quick)
+        + pipeline_rows(quick)
+        + pose_detection.run(quick, mocap)
+    )

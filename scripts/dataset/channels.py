@@ -11,7 +11,7 @@ whose motion and body every channel shares, and a channel seed.
   the rendered visibility of :func:`render_cams.fisheye.keypoints.visibility` needs a range
   image per frame, which a keypoints-only dataset does not render. ``fisheye_uv`` and
   ``fisheye_conf`` are what a 2D detector reports
-  (:class:`render_cams.fisheye.detector.KeypointDetector`, its default error model,
+  (:class:`render_cams.fisheye.detector.ErrorModelDetector`, its default error model,
   seeded): the exact projections are ``fisheye_uv_projected``.
 - :func:`kinect_channel`: the Kinect skeleton with tracking states.
 - :func:`fisheye_image_channel` and the Kinect's depth (:func:`kinect_channel`): rendered
@@ -33,7 +33,7 @@ import numpy as np
 
 from avatar_models.rigs import body17_positions
 from render_cams.device import motion_at_rate
-from render_cams.fisheye.detector import KeypointDetector
+from render_cams.fisheye.detector import ErrorModelDetector
 from render_cams.fisheye.device import CAMERA_RATE_HZ, FisheyeRig
 from render_cams.fisheye.keypoints import confidence, project_joints, world_to_camera
 from render_cams.fisheye.pose2d import controller_views
@@ -107,9 +107,9 @@ def fisheye_channel(humanoid: Humanoid, seed: int) -> Channel:
     )
     uv = uv.reshape(n_frames, n_cams, -1, 2)
     in_view = in_image.reshape(n_frames, n_cams, -1) & ~covered[..., None]
-    detector = KeypointDetector()
+    detector = ErrorModelDetector()
     score = confidence(rig.model, uv, in_view)
-    detection = detector.detect(uv, in_view, in_view, score, np.random.default_rng(seed))
+    detection = detector.detect_projected(uv, in_view, in_view, score, np.random.default_rng(seed))
     views = controller_views(
         rig.model, cameras, uv, in_view, in_view, score, ~covered, detector,
         np.random.default_rng([seed, 1]),
@@ -133,8 +133,8 @@ def fisheye_channel(humanoid: Humanoid, seed: int) -> Channel:
         "cameras": [c.name for c in cameras],
         "model": rig.model.as_dict(),
         "keypoints": "projected (in_view not occlusion-tested; no images rendered), then "
-        "detected by the detector error model",
-        "detector": asdict(detector),
+        'detected by the "error-model" detector (a fast approximation)',
+        "detector": {"name": detector.name, **asdict(detector)},
         "seed": seed,
         "views": view_names,
         "view_sizes": {

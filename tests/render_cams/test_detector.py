@@ -7,7 +7,8 @@ from scipy.stats import spearmanr
 
 from avatar_models.body17 import BODY17, INDEX
 from render_cams.device import DeviceError
-from render_cams.fisheye.detector import BODY17_SIGMAS, KeypointDetector
+from render_cams.fisheye.detector import BODY17_SIGMAS, ErrorModelDetector
+from render_cams.fisheye.pose_detector import ViewTruth
 
 N = 20000
 # A person whose keypoints span a 200 x 400 px box: person size sqrt(200 * 400) px.
@@ -26,7 +27,7 @@ def person(n: int = N) -> np.ndarray:
 def run(detector, visible=True, score=1.0, seed=0, n=N):
     uv = person(n)
     shape = uv.shape[:2]
-    return uv, detector.detect(
+    return uv, detector.detect_projected(
         uv,
         np.ones(shape, bool),
         np.broadcast_to(visible, shape),
@@ -36,7 +37,7 @@ def run(detector, visible=True, score=1.0, seed=0, n=N):
 
 
 def test_localisation_error_is_the_coco_sigma_times_the_person_size():
-    detector = KeypointDetector(error_scale=1.5, occluded_scale=3.0, miss_rate=0.0, swap_rate=0.0)
+    detector = ErrorModelDetector(error_scale=1.5, occluded_scale=3.0, miss_rate=0.0, swap_rate=0.0)
     visible = np.arange(17) % 2 == 0
     uv, detection = run(detector, visible=visible)
     np.testing.assert_allclose(detection.scale_px, SCALE_PX)
@@ -48,12 +49,12 @@ def test_localisation_error_is_the_coco_sigma_times_the_person_size():
 
 
 def test_missed_joints_follow_visibility_and_swaps_their_rate():
-    detector = KeypointDetector(miss_rate=0.6, swap_rate=0.1)
+    detector = ErrorModelDetector(miss_rate=0.6, swap_rate=0.1)
     for score in (1.0, 0.5, 0.1):
         _, detection = run(detector, score=score)
         missed = 1.0 - detection.detected.mean()
         assert missed == pytest.approx(0.6 * (1.0 - score), abs=0.01)
-    uv, detection = run(KeypointDetector(error_scale=0.0, miss_rate=0.0, swap_rate=0.1))
+    uv, detection = run(ErrorModelDetector(error_scale=0.0, miss_rate=0.0, swap_rate=0.1))
     assert detection.swapped.mean(axis=0) == pytest.approx([0.1, 0.1], abs=0.01)
     arms, legs = detection.swapped[:, 0], detection.swapped[:, 1]
     l_wrist, r_wrist, l_foot = INDEX["l_wrist"], INDEX["r_wrist"], INDEX["l_foot"]
@@ -63,7 +64,7 @@ def test_missed_joints_follow_visibility_and_swaps_their_rate():
 
 
 def test_confidence_falls_as_the_error_grows():
-    detector = KeypointDetector(swap_rate=0.0, miss_rate=0.0)
+    detector = ErrorModelDetector(swap_rate=0.0, miss_rate=0.0)
     for seed in (0, 1, 2):
         uv, detection = run(detector, seed=seed, n=2000)
         error = np.linalg.norm(detection.uv - uv, axis=-1) / (BODY17_SIGMAS * SCALE_PX)
@@ -81,7 +82,7 @@ def test_no_person_below_four_joints_and_nothing_out_of_the_image():
     in_image = np.zeros((10, 17), bool)
     in_image[:, :3] = True
     in_image[5:, 3:6] = True
-    detection = KeypointDetector().detect(
+    detection = ErrorModelDetector().detect_projected(
         uv, in_image, np.ones((10, 17), bool), np.ones((10, 17)), np.random.default_rng(0)
     )
     assert not detection.detected[:5].any() and np.all(detection.uv[:5] == 0)
@@ -92,4 +93,28 @@ def test_no_person_below_four_joints_and_nothing_out_of_the_image():
 @pytest.mark.parametrize("bad", [{"miss_rate": 1.5}, {"error_scale": -1.0}, {"swap_rate": np.nan}])
 def test_bad_parameters_are_rejected(bad):
     with pytest.raises(DeviceError, match="detector model"):
-        KeypointDetector(**bad)
+        ErrorModelDetector(**bad)
+
+
+def test_protocol_detect_reports_one_image_as_the_batched_model_does():
+    """The ``"error-model"`` PoseDetector on one image is the batched model on its exact
+    keypoints (same draws), finds no person with 3 joints in the image, and reads no pixel:
+    a black and a white image give the same report."""
+    detector = ErrorModelDetector()
+    uv = person(1)[0]
+    in_image = np.ones(17, bool)
+    truth = ViewTruth(uv, in_image, in_image, np.ones(17))
+    black, white = np.zeros((480, 640, 3), np.uint8), np.full((480, 640, 3), 255, np.uint8)
+    one = detector.detect(black, truth, np.random.default_rng(4))
+    batched = detector.detect_projected(
+        uv, in_image, in_image, np.ones(17), np.random.default_rng(4)
+    )
+    np.testing.assert_array_equal(one.uv, batched.uv)
+    np.testing.assert_array_equal(one.confidence, batched.confidence)
+    assert one.person and one.detector == "error-model"
+    again = detector.detect(white, truth, np.random.default_rng(4))
+    np.testing.assert_array_equal(again.uv, one.uv)
+    few = np.zeros(17, bool)
+    few[:3] = True
+    nobody = detector.detect(black, ViewTruth(uv, few, few, np.ones(17)), np.random.default_rng(4))
+    assert not nobody.person and not nobody.detected.any()

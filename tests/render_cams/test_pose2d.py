@@ -11,7 +11,7 @@ from avatar_models.body17 import INDEX
 from avatar_models.formats import load_motion
 from avatar_models.generator import generate
 from avatar_models.rigs import body17_positions
-from render_cams.fisheye.detector import KeypointDetector
+from render_cams.fisheye.detector import ErrorModelDetector
 from render_cams.fisheye.device import FisheyeRig
 from render_cams.fisheye.keypoints import confidence, project_joints
 from render_cams.fisheye.model import FisheyeModel
@@ -22,7 +22,7 @@ from render_cams.fisheye.torso_view import CORNER_INDICES, apply_homography
 from sim.humanoid import humanoid_for
 
 MODEL = FisheyeModel.from_fov().scaled(0.25)
-EXACT = KeypointDetector(error_scale=0.0, miss_rate=0.0, swap_rate=0.0, confidence_noise=0.0)
+EXACT = ErrorModelDetector(error_scale=0.0, miss_rate=0.0, swap_rate=0.0, confidence_noise=0.0)
 
 
 @pytest.fixture(scope="module")
@@ -73,7 +73,7 @@ def test_torso_view_comes_from_the_detected_torso_and_is_detected_again(pair):
     found = exact.torso_detection.detected
     np.testing.assert_allclose(exact.torso_detection.uv[found], exact.torso_uv[found], atol=1e-9)
     # A noisy detector builds its view from its own (noisy) shoulders and hips.
-    noisy = controller_pose2d(params, KeypointDetector(), composite, np.random.default_rng(1))
+    noisy = controller_pose2d(params, ErrorModelDetector(), composite, np.random.default_rng(1))
     ok = noisy.torso.valid
     reported = noisy.composite_detection.uv[ok][:, CORNER_INDICES]
     np.testing.assert_allclose(
