@@ -18,7 +18,7 @@ from avatar_models.config import ConfigError
 
 MEMORY_LIMIT_ENV = "AVATARSIM_MEMORY_LIMIT"
 UNITS = {"": 1, "K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}
-FRAME_BYTES = 65536
+FRAME_BYTES = 262144
 """Bytes one frame of motion costs a run or a dataset sample: the motion on its rig, the
 humanoid's replay, the device streams and the per-frame reports (an upper estimate)."""
 
@@ -46,7 +46,7 @@ def format_bytes(n: float) -> str:
     """``n`` bytes for a message, in binary units: ``"3.2 GiB"``."""
     units = ("B", "KiB", "MiB", "GiB", "TiB", "PiB")
     k = min(int(math.log(n, 1024)), len(units) - 1) if math.isfinite(n) and n >= 1024 else 0
-    return f"{n / 1024**k:.1f} {units[k]}"
+    return f"{n / 1024**k:.3g} {units[k]}"
 
 
 def require_memory(estimate: float, what: str) -> None:

@@ -16,13 +16,13 @@ Two terms (bytes), each scaling with a size of the config:
 
 from __future__ import annotations
 
-from avatar_models.memory import FRAME_BYTES, require_memory
+from avatar_models.memory import FRAME_BYTES, format_bytes, require_memory
 from render_cams.fisheye.device import CAMERA_RATE_HZ
 from render_cams.fisheye.model import PAPER_SIZE
 from render_cams.fisheye.rig import controller_cameras
 from render_cams.kinect.sensors import get_sensor
 
-PLAN_BYTES_PER_SAMPLE = 2048
+PLAN_BYTES_PER_SAMPLE = 1024
 FISHEYE_PIXEL_BYTES = 5
 
 
@@ -60,6 +60,7 @@ def check_budget(config) -> None:
     plan, sample = samples * PLAN_BYTES_PER_SAMPLE, sample_bytes(config)
     require_memory(
         plan + sample,
-        f"this config ({samples:.3g} samples of {config.window.seconds:g} s x "
-        f"{config.window.fps:g} fps: plan {plan:.3g} B + one sample {sample:.3g} B)",
+        f"{samples:.3g} samples (sources.subjects x activities x windows, x devices) of window.seconds x window.fps "
+        f"= {config.window.seconds:g} s x {config.window.fps:g} fps (plan {format_bytes(plan)}"
+        f" + one sample {format_bytes(sample)})",
     )
