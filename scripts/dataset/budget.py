@@ -60,7 +60,7 @@ def check_budget(config) -> None:
     plan, sample = samples * PLAN_BYTES_PER_SAMPLE, sample_bytes(config)
     require_memory(
         plan + sample,
-        f"{samples:.3g} samples (sources.subjects x activities x windows, x devices) of window.seconds x window.fps "
-        f"= {config.window.seconds:g} s x {config.window.fps:g} fps (plan {format_bytes(plan)}"
+        f"{samples:.3g} samples (sources.subjects x activities x windows, x devices) of "
+        f"window.seconds x window.fps = {config.window.seconds:g} s x {config.window.fps:g} fps (plan {format_bytes(plan)}"
         f" + one sample {format_bytes(sample)})",
     )
