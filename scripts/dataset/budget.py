@@ -61,6 +61,6 @@ def check_budget(config) -> None:
     require_memory(
         plan + sample,
         f"{samples:.3g} samples (sources.subjects x activities x windows, x devices) of "
-        f"window.seconds x window.fps = {config.window.seconds:g} s x {config.window.fps:g} fps (plan {format_bytes(plan)}"
-        f" + one sample {format_bytes(sample)})",
+        f"window.seconds x window.fps = {config.window.seconds:g} s x {config.window.fps:g} fps "
+        f"(plan {format_bytes(plan)} + one sample {format_bytes(sample)})",
     )
