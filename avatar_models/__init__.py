@@ -13,6 +13,7 @@ os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"])
 
 from avatar_models.errors import (
     AvatarsimError,
+    CalibrationError,
     MotionFormatError,
     MotionValueError,
     RigError,
@@ -23,6 +24,7 @@ from avatar_models.skeleton import Skeleton
 
 __all__ = [
     "AvatarsimError",
+    "CalibrationError",
     "Motion",
     "MotionFormatError",
     "MotionValueError",

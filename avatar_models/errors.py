@@ -43,5 +43,11 @@ class RigError(AvatarsimError):
     """A rig description file is invalid, or no rig matches a skeleton."""
 
 
+class CalibrationError(AvatarsimError, ValueError):
+    """A calibration that its input cannot identify: too few checkerboard views of a camera,
+    a failed solve, a walk-in sample that does not tell the trackers apart. The message says
+    what to fix."""
+
+
 class MotionValueError(AvatarsimError, ValueError):
     """Motion data with impossible values: NaN, zero frames, wrong shapes, bad fps or units."""

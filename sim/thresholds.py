@@ -72,90 +72,61 @@ Load overrides from a dict or a TOML file (flat keys, the field names below)::
 
 from __future__ import annotations
 
-import math
-import tomllib
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass, fields, replace
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from avatar_models.errors import AvatarsimError
-
-# Sane bounds of the definitions (low, high, must be > 0): beyond them a check measures
-# nothing meaningful (a 1 m "contact" height, a contact lasting 10 s). Thresholds only need
-# to be finite and >= 0.
-SETTING_RANGES: dict[str, tuple[float, float, bool]] = {
-    "contact_height_m": (0.0, 0.5, True),
-    "contact_vz_m_s": (0.0, 10.0, True),
-    "contact_min_s": (0.0, 2.0, False),
-    "contact_vxy_m_s": (0.0, 20.0, True),
-    "float_window_s": (0.0, 10.0, False),
-    "skate_speed_cm_s": (0.0, 1000.0, False),
-    "limit_tolerance_deg": (0.0, 180.0, False),
-    "limit_min_range_deg": (0.0, 360.0, False),
-    "self_collision_depth_cm": (0.0, 50.0, False),
-    "residual_cutoff_hz": (0.0, 500.0, True),
-    "friction": (0.0, 10.0, True),
-}
-
-
-class ConfigError(AvatarsimError):
-    """A plausibility configuration with an unknown key or a bad value."""
+from avatar_models.config import ConfigError, from_data, read_toml, setting
 
 
 @dataclass(frozen=True)
 class CheckConfig:
-    """Definitions (first block) and pass/fail thresholds (second block). See the module."""
+    """Definitions (first block) and pass/fail thresholds (second block). See the module.
+
+    The definitions have sane bounds: beyond them a check measures nothing meaningful (a 1 m
+    "contact" height, a contact lasting 10 s). Thresholds only need to be finite and >= 0.
+    """
 
     # -- definitions --------------------------------------------------------------------
-    contact_height_m: float = 0.05
-    contact_vz_m_s: float = 0.3
-    contact_min_s: float = 0.07
-    contact_vxy_m_s: float = 2.5
-    float_window_s: float = 0.5
-    skate_speed_cm_s: float = 10.0
-    limit_tolerance_deg: float = 20.0
-    limit_min_range_deg: float = 20.0
-    self_collision_depth_cm: float = 5.0
-    residual_cutoff_hz: float = 10.0
-    friction: float = 1.0
+    contact_height_m: float = setting(0.05, gt=0.0, le=0.5)
+    contact_vz_m_s: float = setting(0.3, gt=0.0, le=10.0)
+    contact_min_s: float = setting(0.07, ge=0.0, le=2.0)
+    contact_vxy_m_s: float = setting(2.5, gt=0.0, le=20.0)
+    float_window_s: float = setting(0.5, ge=0.0, le=10.0)
+    skate_speed_cm_s: float = setting(10.0, ge=0.0, le=1000.0)
+    limit_tolerance_deg: float = setting(20.0, ge=0.0, le=180.0)
+    limit_min_range_deg: float = setting(20.0, ge=0.0, le=360.0)
+    self_collision_depth_cm: float = setting(5.0, ge=0.0, le=50.0)
+    residual_cutoff_hz: float = setting(10.0, gt=0.0, le=500.0)
+    friction: float = setting(1.0, gt=0.0, le=10.0)
     # -- pass/fail thresholds (clip values must be <= these) ----------------------------
-    penetration_cm_p95: float = 5.0
-    float_cm_p95: float = 5.0
-    skate_cm_s_median: float = 40.0
-    skate_slide_cm_max: float = 10.0
-    joint_limit_violation_frac: float = 0.05
-    self_collision_frac: float = 0.5
-    jitter_m_s3_median: float = 10000.0
-    residual_force_bw_p95: float = 0.5
+    penetration_cm_p95: float = setting(5.0, ge=0.0)
+    float_cm_p95: float = setting(5.0, ge=0.0)
+    skate_cm_s_median: float = setting(40.0, ge=0.0)
+    skate_slide_cm_max: float = setting(10.0, ge=0.0)
+    joint_limit_violation_frac: float = setting(0.05, ge=0.0)
+    self_collision_frac: float = setting(0.5, ge=0.0)
+    jitter_m_s3_median: float = setting(10000.0, ge=0.0)
+    residual_force_bw_p95: float = setting(0.5, ge=0.0)
 
     def as_dict(self) -> dict[str, float]:
         return asdict(self)
 
     @classmethod
-    def from_dict(cls, values: Mapping[str, Any]) -> CheckConfig:
-        """Defaults overridden by ``values``; unknown keys and non-positive values raise."""
-        known = {f.name for f in fields(cls)}
-        unknown = sorted(set(values) - known)
-        if unknown:
-            raise ConfigError(f"unknown check setting(s) {unknown}; known: {sorted(known)}")
-        for key, value in values.items():
-            if isinstance(value, bool) or not isinstance(value, int | float) or not value >= 0:
-                raise ConfigError(f"check setting {key!r} must be a number >= 0, got {value!r}")
-            lo, hi, positive = SETTING_RANGES.get(key, (0.0, float("inf"), False))
-            if not math.isfinite(value) or not lo <= value <= hi or (positive and value == 0):
-                span = f"{'(' if positive else '['}{lo:g}, {hi:g}]"
-                raise ConfigError(f"check setting {key!r} must be in {span}, got {value!r}")
-        return replace(cls(), **{k: float(v) for k, v in values.items()})
+    def from_dict(cls, values: Mapping[str, Any], where: str = "") -> CheckConfig:
+        """Defaults overridden by ``values`` (:func:`avatar_models.config.from_data`)."""
+        return from_data(cls, values, where)
 
     @classmethod
     def from_toml(cls, path: str | Path) -> CheckConfig:
+        """The settings of a TOML file: flat keys, or all of them in one ``[checks]`` table."""
+        data = read_toml(path)
+        table, where = (data["checks"], "checks") if set(data) == {"checks"} else (data, "")
         try:
-            with open(path, "rb") as fh:
-                values = tomllib.load(fh)
-        except (OSError, tomllib.TOMLDecodeError) as exc:
-            raise ConfigError(f"cannot read check config {path}: {exc}") from exc
-        return cls.from_dict(values.get("checks", values))
+            return cls.from_dict(table, where)
+        except ConfigError as exc:
+            raise ConfigError(f"{path}: {exc}") from None
 
 
 THRESHOLD_KEYS: dict[str, str] = {

@@ -26,7 +26,7 @@ import cv2
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from avatar_models import AvatarsimError
+from avatar_models import CalibrationError
 from render_cams.fisheye.model import FisheyeModel
 
 PATTERN = (9, 6)  # inner corners (columns, rows), OpenCV's calibration sample
@@ -39,10 +39,6 @@ TILT_DEG = 40.0  # largest tilt of the board away from facing the camera
 EDGE_MARGIN_PX = 6.0  # the whole board (with its white margin) stays this far inside
 CALIBRATION_FLAGS = cv2.CALIB_RECOMPUTE_EXTRINSIC | cv2.CALIB_CHECK_COND | cv2.CALIB_FIX_SKEW
 DETECTOR_FLAGS = cv2.CALIB_CB_NORMALIZE_IMAGE | cv2.CALIB_CB_EXHAUSTIVE | cv2.CALIB_CB_ACCURACY
-
-
-class CalibrationError(AvatarsimError, RuntimeError):
-    """Too few checkerboard views were detected, or OpenCV's calibration failed."""
 
 
 def board_corners() -> np.ndarray:

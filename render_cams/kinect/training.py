@@ -12,20 +12,21 @@ thresholds) on the same frames. Deterministic for a config and seed.
 from __future__ import annotations
 
 import hashlib
-import tomllib
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
 
+from avatar_models.config import ConfigError, load_toml, setting
 from avatar_models.generator import generate, sample_subject
+from avatar_models.memory import require_memory
 from avatar_models.rigs import body17_positions
 from render_cams.kinect.depth import KinectDepthCamera
 from render_cams.kinect.features import DepthFeatures, body_depth
 from render_cams.kinect.forest import from_sklearn
 from render_cams.kinect.parts import N_PARTS, paint_parts
 from render_cams.kinect.placement import default_sensor_pose, performer_target
-from render_cams.kinect.sensors import KinectError, get_sensor
+from render_cams.kinect.sensors import SENSORS, get_sensor
 from render_cams.kinect.tracker import BodyPartTracker
 from render_cams.scene import BodyScene
 
@@ -35,47 +36,46 @@ class TrackerTrainingConfig:
     """What the tracker is trained on and how (see ``models/kinect-tracker.toml``)."""
 
     sensor: str = "kinect-v2"
-    seed: int = 0
-    subjects: int = 6
-    activities: tuple[str, ...] = ("walk", "wave", "squat", "box", "lunge", "kick", "balance")
-    seconds: float = 2.0
-    frames_per_clip: int = 3
-    yaw_deg: tuple[float, ...] = (-45.0, 0.0, 45.0)
-    pixels_per_frame: int = 400
-    features: int = 200
-    max_offset_m: float = 0.5
-    trees: int = 3
-    max_depth: int = 18
-    min_samples_leaf: int = 20
+    seed: int = setting(0, ge=0)
+    subjects: int = setting(6, ge=1)
+    activities: tuple[str, ...] = setting(
+        ("walk", "wave", "squat", "box", "lunge", "kick", "balance"), min_items=1
+    )
+    seconds: float = setting(2.0, gt=0.0)
+    frames_per_clip: int = setting(3, ge=1)
+    yaw_deg: tuple[float, ...] = setting((-45.0, 0.0, 45.0), min_items=1)
+    pixels_per_frame: int = setting(400, ge=1)
+    features: int = setting(200, ge=1)
+    max_offset_m: float = setting(0.5, gt=0.0)
+    trees: int = setting(3, ge=1)
+    max_depth: int = setting(18, ge=1)
+    min_samples_leaf: int = setting(20, ge=1)
 
-    def __post_init__(self) -> None:
-        get_sensor(self.sensor)
-        counts = (self.subjects, self.frames_per_clip, self.pixels_per_frame, self.features)
-        if min(counts) < 1 or self.trees < 1 or self.max_depth < 1 or not self.activities:
-            raise KinectError("tracker training counts must be at least 1")
+    def memory_bytes(self) -> float:
+        """Bytes training holds: every rendered frame's depth (uint16) and part labels
+        (uint8) at the sensor's size, and the float32 feature matrix of the sampled pixels
+        (``pixels_per_frame x features`` a frame)."""
+        sensor = get_sensor(self.sensor)
+        n = float(self.subjects) * len(self.activities) * self.frames_per_clip * len(self.yaw_deg)
+        return n * (
+            3.0 * sensor.width * sensor.height + 4.0 * self.pixels_per_frame * self.features
+        )
 
 
 def load_training_config(path: str | Path) -> TrackerTrainingConfig:
-    """The config in TOML file ``path``.
+    """The config in TOML file ``path`` (:mod:`avatar_models.config`).
 
     Raises:
-        KinectError: unreadable file, unknown keys or bad values.
+        ConfigError: unreadable file, unknown keys, bad values, or more memory than the
+        machine has (:func:`avatar_models.memory.require_memory`).
     """
-    try:
-        data = tomllib.loads(Path(path).read_text())
-    except (OSError, tomllib.TOMLDecodeError) as exc:
-        raise KinectError(f"{path}: not a readable TOML file ({exc})") from exc
-    known = {f.name for f in fields(TrackerTrainingConfig)}
-    unknown = set(data) - known
-    if unknown:
-        raise KinectError(f"{path}: unknown keys {sorted(unknown)}; known: {sorted(known)}")
-    for key in ("activities", "yaw_deg"):
-        if key in data:
-            data[key] = tuple(data[key])
-    try:
-        return TrackerTrainingConfig(**data)
-    except (TypeError, ValueError) as exc:
-        raise KinectError(f"{path}: {exc}") from exc
+    config = load_toml(TrackerTrainingConfig, path)
+    if config.sensor not in SENSORS:
+        raise ConfigError(
+            f"{path}: sensor must be one of {', '.join(SENSORS)}, got {config.sensor!r}"
+        )
+    require_memory(config.memory_bytes(), f"{path}: the tracker's training frames")
+    return config
 
 
 def orbit(pose: np.ndarray, centre: np.ndarray, yaw_rad: float) -> np.ndarray:

@@ -20,7 +20,6 @@ from typing import Any
 import numpy as np
 
 from avatar_models.body17 import BODY17
-from avatar_models.errors import AvatarsimError
 from avatar_models.fileio import write_json
 from scripts.controllerpose.coolmoves_baseline import coolmoves_positions, training_motions
 from scripts.controllerpose.data import load_examples, mocap_examples, mocap_files, split_streams
@@ -35,11 +34,7 @@ from synthesis.controllerpose.evaluate import (
 )
 from synthesis.controllerpose.examples import Examples
 from synthesis.coolmoves import build_database
-
-
-class EvaluationError(AvatarsimError, ValueError):
-    """Options of ``eval controllerpose`` that cannot work."""
-
+from synthesis.evaluate import EvaluationError
 
 MOCAP_SECONDS = 4.0
 PAPER = {"mean_cm": 6.98, "sd_cm": 4.2, "limbs_mean_cm": 8.59, "no_vr_mean_cm": 8.76}

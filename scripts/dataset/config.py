@@ -12,33 +12,34 @@ from __future__ import annotations
 
 import hashlib
 import json
-import tomllib
+from collections.abc import Mapping
 from dataclasses import MISSING, asdict, dataclass, field, fields, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
-from avatar_models.errors import AvatarsimError
+from avatar_models.config import ConfigError, from_data, read_toml, setting
 from avatar_models.generator import ACTIVITIES
+from avatar_models.motion import FPS_RANGE
 from render_cams.fisheye.device import SCALE_RANGE
+from scripts.dataset.budget import check_budget
 
 SPLITS = ("train", "val", "test")
-VR_NOISE = ("none", "realistic")
-KINECT_SENSORS = ("none", "kinect-v2", "azure-kinect")
-IMAGE_FORMATS = ("none", "jpeg", "png")
-MOCAP_SPLIT_BY = ("clip", "performer")
 SPLIT_TOLERANCE = 1e-6
-
-
-class ConfigError(AvatarsimError):
-    """A dataset config that cannot be used (path and reason)."""
+SourceKind = Literal["builtin", "mocap"]
+VrNoise = Literal["none", "realistic"]
+KinectSensor = Literal["none", "kinect-v2", "azure-kinect"]
+ImageFormat = Literal["none", "jpeg", "png"]
+MocapSplitBy = Literal["clip", "performer"]
 
 
 @dataclass(frozen=True)
 class WindowConfig:
-    """One sample is one window of a clip: ``seconds`` long, ground truth at ``fps``."""
+    """One sample is one window of a clip: ``seconds`` long, ground truth at ``fps`` (Hz, in
+    :data:`avatar_models.motion.FPS_RANGE`). Their product is bounded by memory
+    (:mod:`scripts.dataset.budget`)."""
 
-    seconds: float = 4.0
-    fps: float = 30.0
+    seconds: float = setting(4.0, gt=0.0)
+    fps: float = setting(30.0, ge=FPS_RANGE[0], le=FPS_RANGE[1])
 
 
 @dataclass(frozen=True)
@@ -56,12 +57,12 @@ class SourceConfig:
         split_by: mocap: ``"clip"`` or ``"performer"`` (the library's subject label).
     """
 
-    kind: str
+    kind: SourceKind
     activities: tuple[str, ...] = ()
-    subjects: int = 0
-    windows: int = 1
+    subjects: int = setting(0, ge=0)
+    windows: int = setting(1, ge=1)
     path: str = ""
-    split_by: str = "clip"
+    split_by: MocapSplitBy = "clip"
 
 
 @dataclass(frozen=True)
@@ -69,7 +70,7 @@ class DeviceSetConfig:
     """What one sample records of its window.
 
     Attributes:
-        name: the device set's name (part of every sample key).
+        name: the device set's name (part of every sample key; default ``set{k}``).
         vr: headset + controllers at 90 Hz; ``trackers`` adds the Vive trackers.
         vr_noise: ``"none"`` or ``"realistic"`` (scripts.stages.devices.REALISTIC_NOISE).
         fisheye: projected 2D keypoints of the controller cameras.
@@ -88,13 +89,13 @@ class DeviceSetConfig:
     name: str
     vr: bool = True
     trackers: bool = False
-    vr_noise: str = "none"
+    vr_noise: VrNoise = "none"
     fisheye: bool = True
-    fisheye_images: str = "none"
-    kinect: str = "none"
+    fisheye_images: ImageFormat = "none"
+    kinect: KinectSensor = "none"
     kinect_depth: bool = False
-    image_stride: int = 3
-    image_scale: float = 0.5
+    image_stride: int = setting(3, ge=1)
+    image_scale: float = setting(0.5, ge=SCALE_RANGE[0], le=SCALE_RANGE[1])
     physics: bool = True
 
 
@@ -103,11 +104,12 @@ class DatasetConfig:
     """A whole dataset config (module docstring)."""
 
     name: str
-    seed: int = 0
-    samples_per_shard: int = 64
+    seed: int = setting(0, ge=0)
+    samples_per_shard: int = setting(64, ge=1)
     window: WindowConfig = field(default_factory=WindowConfig)
-    splits: dict[str, float] = field(
-        default_factory=lambda: dict(zip(SPLITS, (0.8, 0.1, 0.1), strict=True))
+    splits: dict[str, float] = setting(
+        default_factory=lambda: dict(zip(SPLITS, (0.8, 0.1, 0.1), strict=True)),
+        max_items=len(SPLITS),
     )
     sources: tuple[SourceConfig, ...] = ()
     devices: tuple[DeviceSetConfig, ...] = ()
@@ -143,21 +145,18 @@ def _without_defaults(table: Any) -> dict[str, Any]:
 
 
 def load_config(path: str | Path) -> DatasetConfig:
-    """The config in the TOML file ``path``.
+    """The config in the TOML file ``path``, its memory estimate checked
+    (:func:`scripts.dataset.budget.check_budget`).
 
     Raises:
-        ConfigError: unreadable file, bad TOML, unknown key, empty source, bad split
-        fractions or values.
+        ConfigError: unreadable file, bad TOML, unknown key, a value of the wrong type or
+        range, empty source, bad split fractions, more memory than the machine has.
     """
     path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise ConfigError(f"{path}: cannot read: {exc.strerror or exc}") from None
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{path}: not valid TOML: {exc}") from None
+    data = read_toml(path)
     try:
         config = from_dict(data)
+        check_budget(config)
     except ConfigError as exc:
         raise ConfigError(f"{path}: {exc}") from None
     # A relative mocap folder is relative to the config file, as a scenario's motion path is.
@@ -170,61 +169,37 @@ def load_config(path: str | Path) -> DatasetConfig:
     return replace(config, sources=sources)
 
 
-def from_dict(data: dict[str, Any]) -> DatasetConfig:
+def from_dict(data: Any) -> DatasetConfig:
     """A checked :class:`DatasetConfig` from plain data (a parsed TOML or a manifest's copy)."""
-    top = _known(data, DatasetConfig, "the config")
-    if "name" not in top:
-        raise ConfigError("the config needs a name")
-    window = WindowConfig(**_known(top.pop("window", {}), WindowConfig, "[window]"))
-    splits = _splits(top.pop("splits", DatasetConfig(name="").splits))
-    sources = tuple(_source(s, k) for k, s in enumerate(_tables(top.pop("sources", []))))
-    devices = tuple(_device(d, k) for k, d in enumerate(_tables(top.pop("devices", []))))
-    config = DatasetConfig(window=window, splits=splits, sources=sources, devices=devices, **top)
+    devices = data.get("devices") if isinstance(data, Mapping) else None
+    if isinstance(devices, list):  # a device set's name defaults to its position
+        named = [
+            {"name": f"set{k}"} | d if isinstance(d, Mapping) else d for k, d in enumerate(devices)
+        ]
+        data = {**data, "devices": named}
+    config = from_data(DatasetConfig, data)
+    config = replace(config, sources=tuple(_source(s, k) for k, s in enumerate(config.sources)))
+    for k, device in enumerate(config.devices):
+        _device(device, k)
+    _splits(config.splits)
     _check(config)
     return config
 
 
-def _known(data: Any, cls: type, where: str) -> dict[str, Any]:
-    if not isinstance(data, dict):
-        raise ConfigError(f"{where} must be a table, got {type(data).__name__}")
-    names = {f.name for f in fields(cls)}
-    unknown = sorted(set(data) - names)
-    if unknown:
-        raise ConfigError(
-            f"unknown key {unknown[0]!r} in {where}; known: {', '.join(sorted(names))}"
-        )
-    return dict(data)
-
-
-def _tables(value: Any) -> list[dict]:
-    if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
-        raise ConfigError("[[sources]] and [[devices]] must be arrays of tables")
-    return value
-
-
-def _splits(value: Any) -> dict[str, float]:
-    if not isinstance(value, dict):
-        raise ConfigError(f"[splits] must be a table, got {type(value).__name__}")
-    splits = dict(value)
+def _splits(splits: dict[str, float]) -> None:
     unknown = sorted(set(splits) - set(SPLITS))
     if unknown:
         raise ConfigError(f"unknown split {unknown[0]!r} in [splits]; known: {', '.join(SPLITS)}")
-    out = {}
-    for name in SPLITS:
-        fraction = splits.get(name, 0.0)
-        if not isinstance(fraction, int | float) or not 0.0 <= fraction <= 1.0:
-            raise ConfigError(f"split {name} must be a fraction in [0, 1], got {fraction!r}")
-        out[name] = float(fraction)
-    if abs(sum(out.values()) - 1.0) > SPLIT_TOLERANCE:
-        raise ConfigError(f"split fractions must sum to 1, got {sum(out.values()):g} ({out})")
-    return out
+    for name, fraction in splits.items():
+        if not 0.0 <= fraction <= 1.0:
+            raise ConfigError(f"splits.{name} must be a fraction in [0, 1], got {fraction!r}")
+    total = sum(splits.values())
+    if abs(total - 1.0) > SPLIT_TOLERANCE:
+        raise ConfigError(f"split fractions must sum to 1, got {total:g} ({splits})")
 
 
-def _source(data: dict, index: int) -> SourceConfig:
-    where = f"[[sources]] #{index + 1}"
-    values = _known(data, SourceConfig, where)
-    values["activities"] = tuple(values.get("activities", ()))
-    source = SourceConfig(**values)
+def _source(source: SourceConfig, index: int) -> SourceConfig:
+    where = f"sources[{index}]"
     if source.kind == "builtin":
         unknown = sorted(set(source.activities) - set(ACTIVITIES))
         if unknown:
@@ -234,49 +209,23 @@ def _source(data: dict, index: int) -> SourceConfig:
         if not source.activities:
             source = replace(source, activities=ACTIVITIES)
         if source.subjects < 1:
-            raise ConfigError(f"{where}: an empty source: subjects must be at least 1")
-    elif source.kind == "mocap":
-        if not source.path:
-            raise ConfigError(f"{where}: a mocap source needs a path")
-        if source.split_by not in MOCAP_SPLIT_BY:
-            raise ConfigError(f"{where}: split_by must be one of {', '.join(MOCAP_SPLIT_BY)}")
-    else:
-        raise ConfigError(f"{where}: kind must be 'builtin' or 'mocap', got {source.kind!r}")
-    if source.windows < 1:
-        raise ConfigError(f"{where}: an empty source: windows must be at least 1")
+            raise ConfigError(f"{where}.subjects: an empty source: subjects must be at least 1")
+    elif not source.path:
+        raise ConfigError(f"{where}.path: a mocap source needs a path")
     return source
 
 
-def _device(data: dict, index: int) -> DeviceSetConfig:
-    where = f"[[devices]] #{index + 1}"
-    device = DeviceSetConfig(**_known({"name": f"set{index}"} | data, DeviceSetConfig, where))
-    if device.vr_noise not in VR_NOISE:
-        raise ConfigError(f"{where}: vr_noise must be one of {', '.join(VR_NOISE)}")
-    if device.kinect not in KINECT_SENSORS:
-        raise ConfigError(f"{where}: kinect must be one of {', '.join(KINECT_SENSORS)}")
-    if device.fisheye_images not in IMAGE_FORMATS:
-        raise ConfigError(f"{where}: fisheye_images must be one of {', '.join(IMAGE_FORMATS)}")
+def _device(device: DeviceSetConfig, index: int) -> None:
+    where = f"devices[{index}]"
     if device.fisheye_images != "none" and not device.fisheye:
-        raise ConfigError(f"{where}: fisheye_images needs fisheye = true")
+        raise ConfigError(f"{where}.fisheye_images needs fisheye = true")
     if device.kinect_depth and device.kinect == "none":
-        raise ConfigError(f"{where}: kinect_depth needs a kinect sensor")
-    if not isinstance(device.image_stride, int) or device.image_stride < 1:
-        raise ConfigError(f"{where}: image_stride must be an integer >= 1")
-    lo, hi = SCALE_RANGE
-    if not (isinstance(device.image_scale, int | float) and lo <= device.image_scale <= hi):
-        raise ConfigError(f"{where}: image_scale must be in [{lo:g}, {hi:g}]")
+        raise ConfigError(f"{where}.kinect_depth needs a kinect sensor")
     if not device.name.replace("-", "").isalnum():
-        raise ConfigError(f"{where}: name must be letters, digits and '-', got {device.name!r}")
-    return device
+        raise ConfigError(f"{where}.name must be letters, digits and '-', got {device.name!r}")
 
 
 def _check(config: DatasetConfig) -> None:
-    if not isinstance(config.seed, int) or config.seed < 0:
-        raise ConfigError(f"seed must be an integer >= 0, got {config.seed!r}")
-    if not isinstance(config.samples_per_shard, int) or config.samples_per_shard < 1:
-        raise ConfigError(f"samples_per_shard must be at least 1, got {config.samples_per_shard}")
-    if not (config.window.seconds > 0 and config.window.fps > 0):
-        raise ConfigError(f"[window] seconds and fps must be positive, got {config.window}")
     if not config.sources:
         raise ConfigError("no [[sources]]: a dataset needs at least one motion source")
     if not config.devices:

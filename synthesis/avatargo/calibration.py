@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import quat
+from avatar_models import CalibrationError, quat
 from render_cams.vr import FULL_BODY
 from synthesis.base import SynthesisError
 
@@ -54,19 +54,15 @@ MIN_FEET_GAP_M = 0.05
 """Least sideways distance between the foot trackers to tell left from right (our choice)."""
 
 
-class CalibrationError(SynthesisError):
-    """The walk-in calibration cannot identify the devices (the message says what to fix)."""
-
-
-class MissingDeviceError(CalibrationError):
+class MissingDeviceError(CalibrationError, SynthesisError):
     """A device AvatarGo needs is not tracked."""
 
 
-class NotTPoseError(CalibrationError):
+class NotTPoseError(CalibrationError, SynthesisError):
     """The user is not standing in a T-pose."""
 
 
-class SwappedTrackersError(CalibrationError):
+class SwappedTrackersError(CalibrationError, SynthesisError):
     """The trackers' positions do not tell their roles apart."""
 
 
@@ -77,7 +73,7 @@ def device_class(name: str) -> str:
             return suffix
     if name == "hmd":
         return "hmd"
-    raise CalibrationError(f"device {name!r} is neither a headset, a controller nor a tracker")
+    raise SynthesisError(f"device {name!r} is neither a headset, a controller nor a tracker")
 
 
 @dataclass(frozen=True)

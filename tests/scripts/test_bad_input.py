@@ -193,7 +193,7 @@ def test_negative_seed_exits_2(tmp_path, scenario):
     bad(["info", "builtin:walk", "--seed", "-1"], "--seed", "-1")
     bad(["run", str(scenario), "--seed", "-5", "--out", str(tmp_path / "o")], "--seed")
     scenario.write_text("seed = -3\n")
-    bad(["run", str(scenario), "--out", str(tmp_path / "o")], "seed must be 0 or more")
+    bad(["run", str(scenario), "--out", str(tmp_path / "o")], "seed must be >= 0, got -3")
     assert not (tmp_path / "o").exists()
 
 
@@ -238,7 +238,7 @@ def test_absurd_numbers_exit_2(tmp_path, clip):
 @pytest.mark.parametrize(
     "toml, expected",
     [
-        ("[report]\npicture_frames = 100000\n", "report.picture_frames must be 1-50"),
+        ("[report]\npicture_frames = 100000\n", "report.picture_frames must be >= 1 and <= 50"),
         ("[report]\ngif_fps = 0\n", "report.gif_fps"),
         ("[physics]\ncontact_height_m = inf\n", "contact_height_m"),
         ("[physics]\ncontact_height_m = 3.0\n", "contact_height_m"),
@@ -259,7 +259,10 @@ def test_absurd_scenario_numbers_exit_2(tmp_path, toml, expected):
 def test_absurd_check_config_exits_2(tmp_path, clip):
     cfg = tmp_path / "c.toml"
     cfg.write_text("contact_height_m = inf\n")
-    bad(["check", str(clip), "--config", str(cfg), "--out", str(tmp_path / "o")], "(0, 0.5]")
+    bad(
+        ["check", str(clip), "--config", str(cfg), "--out", str(tmp_path / "o")],
+        "contact_height_m must be a finite number",
+    )
 
 
 # -- motions that are no input for physics -------------------------------------------------
@@ -311,7 +314,7 @@ def test_npz_with_a_list_meta_or_wrong_is_site_exits_2(tmp_path):
 def test_rich_markup_in_errors_is_shown_as_written(tmp_path):
     sc = tmp_path / "s.toml"
     sc.write_text("[motion]\nspeed = 1.0\n")
-    bad(["run", str(sc)], "unknown key(s) ['speed'] in [motion]")
+    bad(["run", str(sc)], "unknown key 'speed' in [motion]")
     bad(["info", str(tmp_path / "[bold]x.bvh")], "[bold]x.bvh", "no such file")
 
 

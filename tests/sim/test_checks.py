@@ -9,6 +9,7 @@ from scipy.spatial.transform import Rotation
 
 from avatar_models import quat
 from avatar_models.body import build_body
+from avatar_models.config import ConfigError
 from avatar_models.generator import generate
 from avatar_models.motion import Motion
 from sim.checks.joint_limits import JointLimitCheck
@@ -16,7 +17,7 @@ from sim.checks.replay import BodyReplay
 from sim.checks.residual import cone_distance
 from sim.checks.skating import contact_runs, slip_velocity
 from sim.plausibility import check_motion
-from sim.thresholds import CheckConfig, ConfigError
+from sim.thresholds import CheckConfig
 
 
 @pytest.fixture(scope="module")
@@ -131,7 +132,7 @@ def test_config_from_dict_and_toml(tmp_path):
     assert CheckConfig.from_dict({"penetration_cm_p95": 2}).penetration_cm_p95 == 2.0
     with pytest.raises(ConfigError, match="unknown"):
         CheckConfig.from_dict({"no_such_key": 1.0})
-    with pytest.raises(ConfigError, match=">= 0"):
+    with pytest.raises(ConfigError, match="friction must be > 0 and <= 10, got -1"):
         CheckConfig.from_dict({"friction": -1.0})
     path = tmp_path / "c.toml"
     path.write_text("[checks]\ncontact_height_m = 0.03\n")

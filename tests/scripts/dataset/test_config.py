@@ -54,7 +54,7 @@ def test_unreadable_and_invalid_toml(tmp_path):
     bad.write_text("name = ")
     with pytest.raises(ConfigError, match="not valid TOML"):
         load_config(bad)
-    with pytest.raises(ConfigError, match="needs a name"):
+    with pytest.raises(ConfigError, match="name is required"):
         from_dict({k: v for k, v in TINY.items() if k != "name"})
 
 
