@@ -25,7 +25,7 @@ from torch.utils.data import IterableDataset, get_worker_info
 
 from scripts.dataset.config import SPLITS
 from scripts.dataset.manifest import DatasetError, read_manifest
-from scripts.dataset.shards import read_samples
+from scripts.dataset.schema import checked_samples
 
 
 class ShardDataset(IterableDataset):
@@ -65,7 +65,9 @@ class ShardDataset(IterableDataset):
         info = get_worker_info()
         rng = np.random.default_rng([self.seed, self.epoch, 0 if info is None else info.id])
         samples = (
-            as_torch(key, sample) for p in self.worker_shards() for key, sample in read_samples(p)
+            as_torch(key, sample)
+            for p in self.worker_shards()
+            for key, sample in checked_samples(p)
         )
         if not self.shuffle_buffer:
             yield from samples
