@@ -52,10 +52,24 @@ def _first(bad: np.ndarray) -> tuple[int, ...] | None:
     return None if hits.size == 0 else tuple(int(i) for i in hits[0])
 
 
-def check_physical(motion: Motion, source: str | Path) -> None:
+def _unit_first(motion: Motion, source: str | Path, error: MotionValueError) -> None:
+    """Raise the height check's error (it names the unit that fits) when the body is no
+    person's height: a wrong unit explains a bound passed; else ``error``."""
+    from avatar_models.measure import check_plausible_height
+
+    try:
+        check_plausible_height(motion)
+    except MotionValueError as wrong_unit:
+        raise MotionValueError(f"{source}: {wrong_unit}") from None
+    raise error
+
+
+def check_physical(motion: Motion, source: str | Path, from_frame: int = 0) -> None:
     """Refuse ``motion`` (read from ``source``) when a joint is farther than
     :data:`MAX_DISTANCE_M` from the origin, or moves faster than :data:`MAX_SPEED_M_S`
-    between two frames (module docstring).
+    between two frames (module docstring), from frame ``from_frame`` on (1: a rest pose kept
+    ahead of the take jumps to its first pose in one frame). A body of no person's height
+    gets the height check's error instead (a wrong unit, named there).
 
     Raises:
         MotionValueError: naming ``source``, the file's frame and the joint channel.
@@ -66,18 +80,28 @@ def check_physical(motion: Motion, source: str | Path) -> None:
         far = ~(np.abs(pos) <= MAX_DISTANCE_M)
         if (hit := _first(far)) is not None:
             t, j, a = hit
-            raise MotionValueError(
-                f"{source}: frame {file_frame(motion, t)} (from 0), joint {names[j]!r} world "
-                f"{AXES[a]} (Z up) = {pos[t, j, a]:.4g} m, more than {MAX_DISTANCE_M:g} m from the "
-                "origin: no capture volume is that large (a wrong unit or a corrupt value?)"
+            _unit_first(
+                motion,
+                source,
+                MotionValueError(
+                    f"{source}: frame {file_frame(motion, t)} (from 0), joint {names[j]!r} world "
+                    f"{AXES[a]} (Z up) = {pos[t, j, a]:.4g} m, more than {MAX_DISTANCE_M:g} m "
+                    "from the origin: no capture volume is that large (a wrong unit or a corrupt "
+                    "value?)"
+                ),
             )
         if motion.n_frames < 2:
             return
         speed = np.linalg.norm(np.diff(pos, axis=0), axis=-1) * motion.fps  # (T-1, J)
+        speed[:from_frame] = 0.0
         if (hit := _first(~(speed <= MAX_SPEED_M_S))) is not None:
             t, j = hit
-            raise MotionValueError(
-                f"{source}: frame {file_frame(motion, t + 1)} (from 0), joint {names[j]!r} "
-                f"moves at {speed[t, j]:.4g} m/s from the frame before, faster than any body "
-                f"part ({MAX_SPEED_M_S:g} m/s; a corrupt value or a wrong frame rate?)"
+            _unit_first(
+                motion,
+                source,
+                MotionValueError(
+                    f"{source}: frame {file_frame(motion, t + 1)} (from 0), joint {names[j]!r} "
+                    f"moves at {speed[t, j]:.4g} m/s from the frame before, faster than any body "
+                    f"part ({MAX_SPEED_M_S:g} m/s; a corrupt value or a wrong frame rate?)"
+                ),
             )

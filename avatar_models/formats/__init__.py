@@ -26,7 +26,8 @@ def load_motion(path: str | Path, **options) -> Motion:
         (:func:`~avatar_models.motion_bounds.check_physical`: file, frame and channel).
     """
     motion = _read_motion(Path(path), **options)
-    check_physical(motion, path)
+    kept_rest_frame = options.get("drop_rest_frame") is False  # its step to the take is a jump
+    check_physical(motion, path, from_frame=int(kept_rest_frame))
     return motion
 
 

@@ -63,7 +63,9 @@ def pick_samples(root: Path, count: int, seed: int, split: str | None) -> list[t
         wanted.setdefault(k, set()).add(i)
     picked = []
     for k, indices in sorted(wanted.items()):
-        for i, (key, sample) in enumerate(checked_samples(root / shards[k]["file"])):
+        for i, (key, sample) in enumerate(
+            checked_samples(root / shards[k]["file"], shards[k]["samples"])
+        ):
             if i in indices:
                 picked.append((key, sample))
     return picked

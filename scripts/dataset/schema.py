@@ -195,11 +195,23 @@ def check_sample(key: str, sample: dict[str, Any], path: Path) -> dict[str, Any]
     return sample
 
 
-def checked_samples(path: Path) -> Iterator[tuple[str, dict[str, Any]]]:
-    """:func:`scripts.dataset.shards.read_samples`, each sample checked (:func:`check_sample`).
+def checked_samples(
+    path: Path, expected: int | None = None
+) -> Iterator[tuple[str, dict[str, Any]]]:
+    """:func:`scripts.dataset.shards.read_samples`, each sample checked (:func:`check_sample`),
+    and (with ``expected``, the manifest's count) as many as the manifest says: a shard cut
+    at a sample's end reads as a shorter tar.
 
     Raises:
-        ShardError: an unreadable shard. DatasetError: a sample off the schema.
+        ShardError: an unreadable shard. DatasetError: a sample off the schema, or another
+            number of samples than ``expected``.
     """
+    count = 0
     for key, sample in read_samples(path):
+        count += 1
+        if expected is not None and count > expected:
+            break
         yield key, check_sample(key, sample, path)
+    if expected is not None and count != expected:
+        held = f"more than {expected}" if count > expected else str(count)
+        raise DatasetError(f"{path}: holds {held} samples, its manifest entry says {expected}")

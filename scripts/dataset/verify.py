@@ -71,7 +71,7 @@ def verify_dataset(root: Path) -> VerifyReport:
         report.shards += 1
         samples = frames = 0
         try:
-            for key, sample in checked_samples(path):
+            for key, sample in checked_samples(path):  # counts compared below
                 meta = sample.get("json", {})
                 samples += 1
                 frames += int(meta.get("frames", 0))
