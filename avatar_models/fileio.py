@@ -80,11 +80,15 @@ def json_safe(value: Any) -> Any:
     return value
 
 
+def json_text(data: Any) -> str:
+    """``data`` as strict JSON text (:func:`json_safe`; other objects as their ``str``),
+    indented by 2, ending in a newline."""
+    return json.dumps(json_safe(data), indent=2, allow_nan=False, default=str) + "\n"
+
+
 def write_json(path: str | Path, data: Any) -> Path:
-    """Write ``data`` to ``path`` atomically as strict JSON (:func:`json_safe`; other objects
-    as their ``str``), indented by 2, ending in a newline."""
-    text = json.dumps(json_safe(data), indent=2, allow_nan=False, default=str)
-    return write_atomic(path, text + "\n")
+    """Write ``data`` to ``path`` atomically as :func:`json_text`."""
+    return write_atomic(path, json_text(data))
 
 
 def write_columns_csv(path: str | Path, columns: Mapping[str, Any]) -> Path:

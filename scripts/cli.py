@@ -94,6 +94,7 @@ def convert(
     """Convert BVH / ASF+AMC / NPZ to BVH or NPZ, optionally resampled."""
     from avatar_models.formats import WRITABLE, save_motion
     from avatar_models.motion import check_fps
+    from scripts.output_file import record_output
 
     if fps is not None:
         check_fps(fps, "--fps")
@@ -106,7 +107,7 @@ def convert(
     m = load_motion_arg(src, unit, seed)
     if fps is not None:
         m = m.resample(fps)
-    save_motion(m, dst)
+    record_output(save_motion(m, dst))
     console.print(f"wrote {escape(str(dst))}: {m.n_frames} frames at {m.fps:g} fps")
     emit_json(json_out, {"src": str(src), "dst": str(dst), "frames": m.n_frames, "fps": m.fps})
 
@@ -166,8 +167,8 @@ def run(
 
     options = SuiteOptions(workers, fail_fast, select, baseline, update_baseline, seed)
     check_options(options)
-    files = {"--baseline": baseline_file(baseline) if update_baseline else None}
-    check_outputs(json_out=json_out, out=out, out_owner="run", files=files)
+    replaced = {"--baseline": baseline_file(baseline) if update_baseline else None}
+    check_outputs(json_out=json_out, out=out, out_owner="run", replaced=replaced)
     if len(scenarios) == 1 and scenarios[0].is_file() and not (select or baseline):
         from scripts.scenario import load_scenario
 

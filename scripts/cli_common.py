@@ -147,16 +147,21 @@ def check_outputs(
     out_owner: str | None = None,
     export: Path | None = None,
     files: dict[str, Path | None] | None = None,
+    replaced: dict[str, Path | None] | None = None,
 ) -> None:
     """Every output path of a command, checked before any work starts (nothing is written):
     ``--json`` (a file), ``--out`` (a folder; with ``out_owner`` one that the command
-    replaces whole, see :func:`scripts.results.atomic_dir`), ``--export`` (a folder) and
-    other ``files`` by option name. Bad paths raise :class:`AvatarsimError` (exit 2)."""
+    replaces whole, see :func:`scripts.results.atomic_dir`), ``--export`` (a folder), other
+    ``files`` by option name (none of them an existing file avatarsim did not write) and
+    files the command ``replaced`` on purpose (checked by the command: ``--update-baseline``).
+    Bad paths raise :class:`AvatarsimError` (exit 2)."""
     from scripts.results import check_output_dir, check_output_file
 
     check_output_file(json_out, "--json")
     for option, path in (files or {}).items():
         check_output_file(path, option)
+    for option, path in (replaced or {}).items():
+        check_output_file(path, option, replaced=True)
     check_output_dir(out, "--out", out_owner)
     check_output_dir(export, "--export")
     if out is not None and out_owner is not None:
@@ -166,7 +171,12 @@ def check_outputs(
                 f"--out {out} is the current folder or above it, and --out is replaced whole; "
                 "choose a folder of its own"
             )
-        named = [("--json", json_out), ("--export", export), *(files or {}).items()]
+        named = [
+            ("--json", json_out),
+            ("--export", export),
+            *(files or {}).items(),
+            *(replaced or {}).items(),
+        ]
         for option, path in named:
             if path is None:
                 continue
@@ -178,11 +188,14 @@ def check_outputs(
                 )
 
 
-def emit_json(path: Path | None, payload: dict[str, Any]) -> None:
+def emit_json(path: Path | None, payload: dict[str, Any], option: str = "--json") -> None:
+    """Write ``payload`` to the user's JSON file ``path`` (none when None), never over a file
+    avatarsim did not write (:mod:`scripts.output_file`)."""
     if path is not None:
-        from avatar_models.fileio import write_json
+        from avatar_models.fileio import json_text
+        from scripts.output_file import write_output
 
-        write_json(path, payload)
+        write_output(path, json_text(payload), option)
 
 
 def export_viewer(humanoid: Humanoid, qpos: np.ndarray, fps: float, export: Path) -> None:

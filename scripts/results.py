@@ -17,6 +17,7 @@ from typing import Any
 
 from avatar_models.errors import AvatarsimError
 from avatar_models.fileio import dir_mode, write_json
+from scripts.output_file import check_replaceable
 from scripts.scenario import Threshold
 
 
@@ -98,9 +99,10 @@ def _check_ancestors(path: Path, option: str) -> Path:
     return existing
 
 
-def check_output_file(path: Path | None, option: str) -> None:
+def check_output_file(path: Path | None, option: str, replaced: bool = False) -> None:
     """Before any work: ``path`` can be written as a file (not a folder, not below a file,
-    in a writable folder). Writes nothing."""
+    in a writable folder) and, unless the command ``replaced`` it on purpose, is not a file
+    avatarsim did not write (:func:`scripts.output_file.check_replaceable`). Writes nothing."""
     if path is None:
         return
     path = Path(path)
@@ -108,6 +110,8 @@ def check_output_file(path: Path | None, option: str) -> None:
         raise AvatarsimError(f"{option} {path} is a folder; give a file name")
     if str(path).endswith(os.sep):
         raise AvatarsimError(f"{option} {path} names a folder; give a file name")
+    if not replaced:
+        check_replaceable(path, option)
     _probe_writable(_check_ancestors(path, option), option, path)
 
 

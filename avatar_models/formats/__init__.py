@@ -2,7 +2,8 @@
 
 ``load_motion(path)`` picks the reader by extension; ``save_motion(motion, path)`` the writer.
 Every reader raises :class:`~avatar_models.errors.MotionFormatError` (with path and line) on
-malformed input and returns a ``Motion`` in metres, Z up.
+malformed input and returns a ``Motion`` in metres, Z up; ``load_motion`` then refuses a
+motion no body could make (:func:`~avatar_models.motion_bounds.check_physical`).
 """
 
 from __future__ import annotations
@@ -11,14 +12,26 @@ from pathlib import Path
 
 from avatar_models.errors import MotionFormatError
 from avatar_models.motion import Motion
+from avatar_models.motion_bounds import check_physical
 
 READABLE = (".bvh", ".amc", ".npz")
 WRITABLE = (".bvh", ".npz")
 
 
 def load_motion(path: str | Path, **options) -> Motion:
-    """Read a motion file. ``options`` go to the format's reader (e.g. ``unit=``, ``asf=``)."""
-    path = Path(path)
+    """Read a motion file. ``options`` go to the format's reader (e.g. ``unit=``, ``asf=``).
+
+    Raises:
+        MotionFormatError: malformed. MotionValueError: physically absurd values
+        (:func:`~avatar_models.motion_bounds.check_physical`: file, frame and channel).
+    """
+    motion = _read_motion(Path(path), **options)
+    kept_rest_frame = options.get("drop_rest_frame") is False  # its step to the take is a jump
+    check_physical(motion, path, from_frame=int(kept_rest_frame))
+    return motion
+
+
+def _read_motion(path: Path, **options) -> Motion:
     suffix = path.suffix.lower()
     if path.is_dir():
         raise MotionFormatError("is a directory, not a motion file", path)

@@ -24,6 +24,7 @@ from rich.markup import escape
 from rich.progress import Progress
 from rich.table import Table
 
+from avatar_models.fileio import write_json
 from scripts.cli_common import (
     JsonOpt,
     SeedOpt,
@@ -111,7 +112,7 @@ def write_leaderboard(board: dict, out: Path, json_out: Path | None) -> None:
     plot = write_plot(board, out / "leaderboard.png")
     (out / "leaderboard.html").write_text(render_page(board, plot))
     board["plot"], board["page"] = str(plot), str(out / "leaderboard.html")
-    emit_json(out / "leaderboard.json", board)
+    write_json(out / "leaderboard.json", board)
     emit_json(json_out, board)
     console.print(f"wrote {out}/leaderboard.json, leaderboard.png and leaderboard.html")
 
@@ -152,7 +153,7 @@ def write_avatargo(results: dict, out: Path, json_out: Path | None) -> None:
     )
     out.mkdir(parents=True, exist_ok=True)
     results["plot"] = str(write_plot(results, out / "avatargo.png"))
-    emit_json(out / "avatargo.json", results)
+    write_json(out / "avatargo.json", results)
     emit_json(json_out, results)
     console.print(f"wrote {out}/avatargo.json and avatargo.png")
 
@@ -251,7 +252,7 @@ def run_movebox(library, out, wanted, per_source, duration, quick, audio, kinect
             "frames": recording.n_frames,
             "files": [str(save_motion(recording, out / f"take{ext}")) for ext in (".npz", ".bvh")],
         }
-    emit_json(out / "movebox.json", results)
+    write_json(out / "movebox.json", results)
     emit_json(json_out, results)
     console.print(f"wrote {out}/movebox.json and {out}/story/ (story.mp4, story.xml)")
 
@@ -384,7 +385,7 @@ def write_protocol(results: dict, out: Path, json_out: Path | None) -> None:
             + escape(f"{fail['class']}/{fail['held_out']}: {fail['reason']}")
         )
     results["plots"] = write_plots(results, out)
-    emit_json(out / "eval.json", results)
+    write_json(out / "eval.json", results)
     emit_json(json_out, results)
     console.print(f"wrote {out}/eval.json and {', '.join(results['plots'].values())}")
 

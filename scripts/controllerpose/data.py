@@ -151,7 +151,7 @@ def mocap_examples(
     Raises:
         DatasetError: the folder has no BVH file.
     """
-    from avatar_models.formats.bvh import read_bvh
+    from avatar_models.formats import load_motion
     from avatar_models.measure import standing_height
     from render_cams.vr import HEADSET_AND_CONTROLLERS, VRSetup
     from scripts.controllerpose.recording import keypoint_recording
@@ -163,7 +163,7 @@ def mocap_examples(
     setup = VRSetup(devices=HEADSET_AND_CONTROLLERS, noise=REALISTIC_NOISE)
     parts, streams = [], {}
     for group, path in enumerate(picked):
-        motion = read_bvh(path)
+        motion = load_motion(path)
         humanoid = humanoid_for(motion[: int(seconds * motion.fps)])
         recording = keypoint_recording(humanoid, seed + group)
         truth = humanoid.motion.sample(recording.time)

@@ -20,19 +20,14 @@ import json
 from pathlib import Path
 from typing import Any
 
-from avatar_models.errors import AvatarsimError
 from avatar_models.fileio import write_json
 from scripts.dataset.config import SPLITS, DatasetConfig, config_hash
+from scripts.dataset.schema import SCHEMA_VERSION, DatasetError, check_manifest
 from scripts.dataset.shards import sha256_file
 
-SCHEMA_VERSION = 1
 STATE_FILE = "dataset.json"
 MANIFEST_FILE = "manifest.json"
 SHARD_DIR = "shards"
-
-
-class DatasetError(AvatarsimError):
-    """A dataset folder that is not what a command needs (missing, foreign, inconsistent)."""
 
 
 def shard_path(root: Path, name: str) -> Path:
@@ -71,6 +66,8 @@ def done_sidecar(root: Path, name: str) -> dict[str, Any] | None:
         recorded = json.loads(sidecar.read_text(encoding="utf-8"))
     except ValueError:
         return None
+    if not isinstance(recorded, dict):
+        return None
     return recorded if recorded.get("sha256") == sha256_file(tar) else None
 
 
@@ -107,17 +104,14 @@ def write_manifest(root: Path, manifest: dict[str, Any]) -> None:
 
 
 def read_manifest(root: Path) -> dict[str, Any]:
-    """The manifest of the dataset in ``root``.
+    """The manifest of the dataset in ``root``, checked against the schema
+    (:func:`scripts.dataset.schema.check_manifest`).
 
     Raises:
-        DatasetError: no dataset there, or its generation has not finished.
+        DatasetError: no dataset there, its generation has not finished, or a field of the
+            manifest is missing or of the wrong type (naming the file and the field).
     """
     if not (root / MANIFEST_FILE).is_file() and (root / STATE_FILE).is_file():
         raise DatasetError(f"{root}: generation has not finished (run generate again to resume)")
     manifest = read_json(root / MANIFEST_FILE, "dataset manifest")
-    if manifest.get("schema_version") != SCHEMA_VERSION:
-        raise DatasetError(
-            f"{root}: manifest schema {manifest.get('schema_version')!r}, "
-            f"this avatarsim reads {SCHEMA_VERSION}"
-        )
-    return manifest
+    return check_manifest(manifest, root / MANIFEST_FILE)

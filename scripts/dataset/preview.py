@@ -18,10 +18,10 @@ from typing import Any
 import numpy as np
 
 from avatar_models.body17 import INDEX
-from avatar_models.fileio import write_atomic
 from scripts.dataset.channels import IMAGE_SUFFIX
 from scripts.dataset.manifest import DatasetError, read_manifest
-from scripts.dataset.shards import read_samples
+from scripts.dataset.schema import checked_samples
+from scripts.output_file import write_output
 
 # body17 drawn as lines, coloured by side: trunk, then each arm and leg outwards.
 TRUNK_LINES = (("head", "neck"), ("neck", "pelvis"))
@@ -63,7 +63,9 @@ def pick_samples(root: Path, count: int, seed: int, split: str | None) -> list[t
         wanted.setdefault(k, set()).add(i)
     picked = []
     for k, indices in sorted(wanted.items()):
-        for i, (key, sample) in enumerate(read_samples(root / shards[k]["file"])):
+        for i, (key, sample) in enumerate(
+            checked_samples(root / shards[k]["file"], shards[k]["samples"])
+        ):
             if i in indices:
                 picked.append((key, sample))
     return picked
@@ -131,7 +133,8 @@ def preview_sheet(
     root: Path, out: Path, samples: int = 12, seed: int = 0, split: str | None = None
 ) -> list[dict[str, Any]]:
     """Write the picture sheet of ``samples`` random samples of ``root`` to the PNG ``out``
-    (atomically); return each panel's key, split, frame and view.
+    (atomically, never over a file avatarsim did not write:
+    :func:`scripts.output_file.write_output`); return each panel's key, split, frame and view.
 
     Raises:
         DatasetError: as :func:`pick_samples`.
@@ -156,5 +159,5 @@ def preview_sheet(
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=100)
     plt.close(fig)
-    write_atomic(out, buffer.getvalue())
+    write_output(out, buffer.getvalue(), "--out")
     return panels

@@ -22,7 +22,13 @@ from typing import Any
 import cv2
 import numpy as np
 
+from avatar_models.errors import AvatarsimError
 from avatar_models.fileio import json_safe
+
+
+class ShardError(AvatarsimError):
+    """A shard that is not a readable tar of samples (truncated, foreign, a damaged entry)."""
+
 
 SampleEntries = tuple[str, dict[str, np.ndarray | bytes], dict[str, Any]]
 IMAGE_EXTENSIONS = (".jpg", ".png")
@@ -80,27 +86,42 @@ def sha256_file(path: Path) -> str:
     return digest.hexdigest()
 
 
+def _decode(ext: str, data: bytes) -> Any:
+    if ext == "json":
+        return json.loads(data)
+    if ext.endswith(IMAGE_EXTENSIONS):
+        return decode_image(data)
+    return np.load(io.BytesIO(data), allow_pickle=False)
+
+
 def read_samples(path: Path) -> Iterator[tuple[str, dict[str, Any]]]:
     """The samples of a shard in order: ``(key, {"json": dict, name: array...})``; images
     decoded, under their entry name with its extension (``fisheye_image.{camera}.0000.jpg``).
 
     Raises:
-        tarfile.TarError: not a tar (a truncated or foreign file).
+        ShardError: not a tar (a truncated or foreign file), or an entry that does not
+            decode (naming the shard and the entry).
     """
-    with tarfile.open(path, mode="r:") as tar:
-        key, sample = None, {}
-        for member in tar:
-            stem, _, ext = member.name.partition(".")
-            if key is not None and stem != key:
-                yield key, sample
-                sample = {}
-            key = stem
-            data = tar.extractfile(member).read()
-            if ext == "json":
-                sample["json"] = json.loads(data)
-            elif ext.endswith(IMAGE_EXTENSIONS):
-                sample[ext] = decode_image(data)
-            else:
-                sample[ext.removesuffix(".npy")] = np.load(io.BytesIO(data), allow_pickle=False)
+    try:
+        tar = tarfile.open(path, mode="r:")
+    except (tarfile.TarError, EOFError) as exc:
+        raise ShardError(f"{path}: not a readable shard (a tar): {exc}") from None
+    with tar:
+        key, sample, name = None, {}, None
+        try:
+            for member in tar:
+                name = member.name
+                stem, _, ext = name.partition(".")
+                if key is not None and stem != key:
+                    yield key, sample
+                    sample = {}
+                key = stem
+                data = tar.extractfile(member).read() if member.isfile() else None
+                if data is None:
+                    raise ValueError("not a file entry")
+                sample["json" if ext == "json" else ext.removesuffix(".npy")] = _decode(ext, data)
+        except (tarfile.TarError, EOFError, OSError, ValueError) as exc:
+            where = f"entry {name!r}" if name is not None else "its first entry"
+            raise ShardError(f"{path}: {where} is damaged ({exc})") from None
         if key is not None:
             yield key, sample

@@ -25,7 +25,7 @@ from torch.utils.data import IterableDataset, get_worker_info
 
 from scripts.dataset.config import SPLITS
 from scripts.dataset.manifest import DatasetError, read_manifest
-from scripts.dataset.shards import read_samples
+from scripts.dataset.schema import checked_samples
 
 
 class ShardDataset(IterableDataset):
@@ -40,7 +40,9 @@ class ShardDataset(IterableDataset):
             raise DatasetError(f"shuffle_buffer must be 0 or more, got {shuffle_buffer}")
         self.root = Path(root)
         manifest = read_manifest(self.root)
-        self.shards = [self.root / s["file"] for s in manifest["shards"] if s["split"] == split]
+        entries = [s for s in manifest["shards"] if s["split"] == split]
+        self.shards = [self.root / s["file"] for s in entries]
+        self.shard_samples = [s["samples"] for s in entries]
         self.samples = manifest["counts"][split]["samples"]
         self.shuffle_buffer = shuffle_buffer
         self.seed = seed
@@ -52,20 +54,22 @@ class ShardDataset(IterableDataset):
     def __len__(self) -> int:
         return self.samples
 
-    def worker_shards(self) -> list[Path]:
-        """This worker's shards for the current epoch."""
+    def worker_shards(self) -> list[tuple[Path, int]]:
+        """This worker's shards for the current epoch, each with its manifest's count."""
         info = get_worker_info()
         worker, workers = (0, 1) if info is None else (info.id, info.num_workers)
         order = np.arange(len(self.shards))
         if self.shuffle_buffer:
             order = np.random.default_rng([self.seed, self.epoch]).permutation(order)
-        return [self.shards[i] for i in order[worker::workers]]
+        return [(self.shards[i], self.shard_samples[i]) for i in order[worker::workers]]
 
     def __iter__(self) -> Iterator[dict[str, Any]]:
         info = get_worker_info()
         rng = np.random.default_rng([self.seed, self.epoch, 0 if info is None else info.id])
         samples = (
-            as_torch(key, sample) for p in self.worker_shards() for key, sample in read_samples(p)
+            as_torch(key, sample)
+            for path, count in self.worker_shards()
+            for key, sample in checked_samples(path, count)
         )
         if not self.shuffle_buffer:
             yield from samples

@@ -8,7 +8,6 @@ and none held out of train found in a train shard; samples and frames per split 
 
 from __future__ import annotations
 
-import tarfile
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -16,7 +15,8 @@ from pathlib import Path
 from scripts.dataset.config import SPLITS, ConfigError, config_hash, from_dict
 from scripts.dataset.manifest import STATE_FILE, read_json, read_manifest
 from scripts.dataset.plan import plan_samples
-from scripts.dataset.shards import read_samples, sha256_file
+from scripts.dataset.schema import DatasetError, checked_samples
+from scripts.dataset.shards import ShardError, sha256_file
 
 MAX_LISTED = 20  # problems listed one by one; more are counted
 
@@ -39,7 +39,9 @@ def verify_dataset(root: Path) -> VerifyReport:
     """Check the dataset in ``root`` (module docstring).
 
     Raises:
-        DatasetError: no finished dataset in ``root``.
+        DatasetError: no finished dataset in ``root``, or a manifest off the schema
+            (:func:`scripts.dataset.schema.check_manifest`); a shard or sample off it is a
+            problem found.
     """
     manifest = read_manifest(root)
     report = VerifyReport()
@@ -52,7 +54,7 @@ def verify_dataset(root: Path) -> VerifyReport:
     if manifest.get("config_hash") != chash:
         problems.append("manifest config_hash does not match its config")
     started = read_json(root / STATE_FILE, "dataset state") if (root / STATE_FILE).is_file() else {}
-    if started and started.get("config_hash") != chash:
+    if started and (not isinstance(started, dict) or started.get("config_hash") != chash):
         problems.append("manifest config differs from the one generation started with")
     planned = {s.key: s for s in plan_samples(config)}
     held_out = {s.window.group for s in planned.values() if s.split != "train"}
@@ -69,7 +71,7 @@ def verify_dataset(root: Path) -> VerifyReport:
         report.shards += 1
         samples = frames = 0
         try:
-            for key, sample in read_samples(path):
+            for key, sample in checked_samples(path):  # counts compared below
                 meta = sample.get("json", {})
                 samples += 1
                 frames += int(meta.get("frames", 0))
@@ -87,7 +89,7 @@ def verify_dataset(root: Path) -> VerifyReport:
                         f"{entry['file']}: sample {key} is {group}/{split} in a "
                         f"{entry['split']} shard; planned {plan.window.group}/{plan.split}"
                     )
-        except (tarfile.TarError, OSError, ValueError) as exc:
+        except (ShardError, DatasetError, OSError) as exc:
             problems.append(f"{entry['file']}: unreadable: {exc}")
         if (samples, frames) != (entry["samples"], entry["frames"]):
             problems.append(

@@ -53,6 +53,8 @@ def check_options(options: SuiteOptions) -> None:
         raise AvatarsimError(f"--workers must be 1-{MAX_WORKERS}, got {options.workers}")
     if options.update_baseline and options.baseline is None:
         raise AvatarsimError("--update-baseline needs --baseline PATH (where to write it)")
+    if options.update_baseline and baseline_file(options.baseline).exists():
+        load_baseline(options.baseline)  # replaced only when it is a baseline (a results.json)
 
 
 def prepare(

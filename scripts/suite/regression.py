@@ -11,6 +11,7 @@ machine, not the method.
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -120,26 +121,72 @@ def baseline_file(path: Path) -> Path:
     return path if path.suffix == ".json" and not path.is_dir() else path / "results.json"
 
 
-def _entry(results: dict[str, Any]) -> tuple[str, BaselineEntry]:
-    return str(results["name"] if "name" in results else results["scenario"]), BaselineEntry(
-        int(results["seeds"]["scenario"]), str(results["scenario_hash"]), results["metrics"]
+def _metric(value: Any) -> bool:
+    """A stored metric: a finite number, or null (NaN as written by ``write_json``)."""
+    return value is None or (
+        isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
     )
 
 
+def _entry(results: Any, file: Path) -> tuple[str, BaselineEntry] | None:
+    """One scenario's baseline from its record in ``file`` (None for a scenario that stored
+    no metrics, e.g. one that errored), every field checked before anything runs.
+
+    Raises:
+        ScenarioError: naming ``file`` and the field that is missing or of the wrong type.
+    """
+
+    def bad(field: str, why: str) -> ScenarioError:
+        return ScenarioError(
+            f"--baseline {file}: {field} {why}; it is not the results.json of an avatarsim "
+            "run (rerun with --update-baseline)"
+        )
+
+    if not isinstance(results, dict):
+        raise bad("a scenario record", f"is {type(results).__name__}, not an object")
+    name = results.get("name", results.get("scenario"))
+    if not isinstance(name, str):
+        raise bad("'name' (or 'scenario')", f"is {name!r}, not a scenario name")
+    metrics = results.get("metrics")
+    if metrics is None:
+        return None
+    if not isinstance(metrics, dict):
+        raise bad(f"{name}: 'metrics'", f"is {type(metrics).__name__}, not an object")
+    wrong = next((k for k, v in metrics.items() if not _metric(v)), None)
+    if wrong is not None:
+        raise bad(f"{name}: metrics[{wrong!r}]", f"is {metrics[wrong]!r}, not a finite number")
+    seeds = results.get("seeds")
+    seed = seeds.get("scenario") if isinstance(seeds, dict) else None
+    if not isinstance(seed, int) or isinstance(seed, bool):
+        raise bad(f"{name}: 'seeds.scenario'", f"is {seed!r}, not an integer")
+    chash = results.get("scenario_hash")
+    if not isinstance(chash, str):
+        raise bad(f"{name}: 'scenario_hash'", f"is {chash!r}, not a hash")
+    return name, BaselineEntry(seed, chash, metrics)
+
+
 def load_baseline(path: Path) -> dict[str, BaselineEntry]:
-    """Scenario name -> its baseline, from a suite's or one scenario's ``results.json``."""
+    """Scenario name -> its baseline, from a suite's or one scenario's ``results.json``.
+
+    Raises:
+        ScenarioError: unreadable, not JSON, or a field of the wrong type (:func:`_entry`).
+    """
     file = baseline_file(path)
     try:
         data = json.loads(file.read_text(encoding="utf-8"))
-        runs = data["scenarios"] if "scenarios" in data else [data]
-        return dict(_entry(r) for r in runs if r.get("metrics") is not None)
     except OSError as exc:
         raise ScenarioError(f"--baseline {file}: cannot read ({exc.strerror or exc})") from None
-    except (ValueError, KeyError, TypeError, AttributeError) as exc:
+    except ValueError as exc:
         raise ScenarioError(
-            f"--baseline {file} is not the results.json of an avatarsim run with scenario "
-            f"hashes ({type(exc).__name__}: {exc}); rerun with --update-baseline"
+            f"--baseline {file} is not JSON ({exc}); give the results.json of an avatarsim run"
         ) from None
+    runs = data.get("scenarios", [data]) if isinstance(data, dict) else data
+    if not isinstance(runs, list):
+        raise ScenarioError(
+            f"--baseline {file}: 'scenarios' is {type(runs).__name__}, not a list of records"
+        )
+    entries = (_entry(r, file) for r in runs)
+    return dict(e for e in entries if e is not None)
 
 
 def check_baseline(

@@ -23,6 +23,8 @@ Shapes: ``T`` animation frames, ``S`` audio samples.
 
 from __future__ import annotations
 
+import struct
+import warnings
 import wave
 from dataclasses import dataclass
 from pathlib import Path
@@ -57,6 +59,14 @@ OPEN_AXIS = np.array([0.0, 1.0, 0.0])
 """Jaw and eyelids turn about their local +y (left) axis: +x (forward) goes down."""
 
 
+MIN_RATE_HZ = 2 * LIP_BAND_HZ[1]
+"""The lowest sampling rate lip sync can use: the upper-lip band reaches 4 kHz, which only a
+rate of twice that holds (Nyquist); 8 kHz is telephone audio, the lowest common PCM rate."""
+MAX_RATE_HZ = 384_000
+"""The highest PCM rate of studio converters; a window two frames long holds ``2 rate / fps``
+samples, so a header claiming more would take memory for nothing."""
+
+
 class AudioFormatError(SynthesisError):
     """An audio file that is not a readable PCM WAV."""
 
@@ -65,19 +75,33 @@ def read_wav(path: str | Path) -> tuple[int, np.ndarray]:
     """``(rate_hz, samples (S,))``: a WAV file as mono float in [-1, 1].
 
     Raises:
-        AudioFormatError: no such file, not a WAV, or no samples.
+        AudioFormatError: no such file, not a WAV, truncated (fewer samples than its header
+            declares), a rate outside :data:`MIN_RATE_HZ`-:data:`MAX_RATE_HZ`, no samples or
+            non-finite ones.
     """
     path = Path(path)
     if not path.is_file():
         raise AudioFormatError(f"{path}: no such audio file")
     try:
-        rate, data = wavfile.read(path)
-    except (ValueError, EOFError, wave.Error) as exc:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", wavfile.WavFileWarning)
+            rate, data = wavfile.read(path)
+    except (ValueError, EOFError, wave.Error, struct.error) as exc:
         raise AudioFormatError(
             f"{path}: unknown audio format ({exc}); give a PCM WAV file"
         ) from exc
+    truncated = [str(w.message) for w in caught if "EOF" in str(w.message)]
+    if truncated:
+        raise AudioFormatError(f"{path}: truncated WAV file ({truncated[0]})")
+    if not MIN_RATE_HZ <= rate <= MAX_RATE_HZ:
+        raise AudioFormatError(
+            f"{path}: sampling rate {rate} Hz; lip sync needs {MIN_RATE_HZ:g}-{MAX_RATE_HZ} Hz "
+            "(its upper-lip band reaches 4 kHz)"
+        )
     if data.size == 0:
         raise AudioFormatError(f"{path}: the WAV file has no samples")
+    if data.dtype.kind == "f" and not np.isfinite(data).all():
+        raise AudioFormatError(f"{path}: the WAV file holds NaN or infinite samples")
     if data.dtype == np.uint8:  # 8-bit WAV is unsigned, centred on 128
         samples = (data.astype(float) - 128.0) / 128.0
     elif np.issubdtype(data.dtype, np.integer):
