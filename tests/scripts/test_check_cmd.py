@@ -64,7 +64,7 @@ def test_bad_input_exits_2_with_a_reason(tmp_path):
     cfg.write_text("nonsense = 1\n")
     path = save_motion(generate("squat", duration_s=0.2), tmp_path / "s.npz")
     result = runner.invoke(app, ["check", str(path), "--config", str(cfg)])
-    assert result.exit_code == 2 and "unknown check setting" in result.stderr
+    assert result.exit_code == 2 and "unknown key 'nonsense'" in result.stderr
 
 
 def test_unknown_rig_exits_2(tmp_path):
