@@ -1,9 +1,9 @@
 """Analytic two-bone inverse kinematics (shoulder-elbow-wrist, hip-knee-ankle) on local rotations.
 
 Shared by the methods: CoolMoves' hand and foot corrections (beyond that paper, which outputs
-blended database poses) and AvatarGo's limbs (:mod:`synthesis.avatargo.analytic_ik`, the
-paper's Unity IK). It moves a limb's end joint to a target with the closed-form two-bone
-solution (law of cosines), as used for arm and leg IK in games (e.g. Unity's
+blended database poses) and AvatarGo's limbs (:mod:`synthesis.avatargo.analytic_ik`, in
+place of the paper's Unity IK). It moves a limb's end joint to a target with the closed-form
+two-bone solution (law of cosines), as used for arm and leg IK in games (e.g. Unity's
 TwoBoneIKConstraint):
 
 - the middle joint (elbow, knee) bends about the normal of its current bend plane, i.e. its

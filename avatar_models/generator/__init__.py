@@ -28,6 +28,7 @@ _ACTIVITY_PLANS: dict[str, Callable[[Scene], Plan]] = {
     "dribble": locomotion.dribble,
     "climb_ladder": ladder.climb_ladder,
     "swim": swim.swim,
+    "arms": exercises.arms,
     "wave": exercises.wave,
     "squat": exercises.squat,
     "lunge": exercises.lunge,

@@ -1,7 +1,8 @@
-"""Activities in place: wave, squat, lunge, front kick, one-leg balance.
+"""Activities in place: arms in and out, wave, squat, lunge, front kick, one-leg balance.
 
-Cycle times at tempo 1: waving 2 Hz (a hand wave's typical side-to-side rate), a squat every
-2.5 s, a lunge every 2.4 s, a kick every 1.6 s. Depths scale with stature and amplitude.
+Cycle times at tempo 1: the arms in and out every 3 s, waving 2 Hz (a hand wave's typical
+side-to-side rate), a squat every 2.5 s, a lunge every 2.4 s, a kick every 1.6 s. Depths
+scale with stature and amplitude.
 """
 
 from __future__ import annotations
@@ -16,8 +17,16 @@ from avatar_models.generator.feet import (
     swing_between,
 )
 from avatar_models.generator.ik import axis_rotation, euler
-from avatar_models.generator.plan import LimbTarget, Plan, Scene
-from avatar_models.generator.poses import X_AXIS, Y_AXIS, arm_angles, gaze, heading_rotation, trunk
+from avatar_models.generator.plan import LimbTarget, Plan, Scene, sided
+from avatar_models.generator.poses import (
+    X_AXIS,
+    Y_AXIS,
+    Z_AXIS,
+    arm_angles,
+    gaze,
+    heading_rotation,
+    trunk,
+)
 from avatar_models.generator.standing import home_ankles, leg_targets, planted_feet, reachable_root
 
 TAU = 2.0 * np.pi
@@ -36,6 +45,43 @@ def _hanging_arms(scene: Scene, sides: str = "LR") -> dict[str, np.ndarray]:
     for side in sides:
         out.update(arm_angles(scene, side, 0.0, np.radians(8.0), np.radians(12.0)))
     return out
+
+
+ARMS_CYCLE_HZ = 1.0 / 3.0
+ARMS_ADDUCTION_RAD = np.radians(60.0)
+"""Horizontal adduction of the upper arm at the innermost point of :func:`arms`."""
+ARMS_ELBOW_RAD = np.radians(110.0)
+"""Elbow flexion at the innermost point of :func:`arms`: the hands end in front of the chest."""
+
+
+def arms(scene: Scene) -> Plan:
+    """AvatarGo's arms task (T1, shared/papers/avatargo.txt §4): from a T-pose, the hands move
+    in towards the chest (upper arms forward in the horizontal plane, elbows bending) and back
+    out, standing still. Starts and ends each cycle in the T-pose (the rig's rest arms)."""
+    n, t = scene.n_frames, scene.times
+    depth = 0.5 - 0.5 * np.cos(TAU * ARMS_CYCLE_HZ * scene.style.tempo * t)  # (T,) 0 = T-pose
+    amp = min(scene.style.amplitude, 1.0)
+    feet = planted_feet(scene)
+    legs, toes = leg_targets(scene, feet)
+    joints = {**toes}
+    for side in "LR":
+        joints[f"Bip01 {side} UpperArm"] = sided(
+            axis_rotation(Z_AXIS, -depth * amp * ARMS_ADDUCTION_RAD), side
+        )
+        joints[f"Bip01 {side} Forearm"] = sided(
+            axis_rotation(Z_AXIS, -depth * amp * ARMS_ELBOW_RAD), side
+        )
+    return Plan(
+        root_pos=reachable_root(scene, _rest_root(scene), scene.constant(np.eye(3)), feet),
+        root_rot=heading_rotation(0.0, n),
+        pelvis=scene.constant(np.eye(3)),
+        spine=trunk(scene),
+        head=gaze(scene, 0.0, 0.0),
+        contacts=np.ones((n, 2), bool),
+        joints=joints,
+        legs=legs,
+        fist=np.full((n, 2), 0.6),
+    )
 
 
 def wave(scene: Scene) -> Plan:

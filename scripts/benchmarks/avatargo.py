@@ -6,8 +6,9 @@ mode) with the six devices and realistic VR noise. Latency is the wall time of e
 machine's other processes do not inflate by preemption), with BLAS on one thread and the
 process pinned to one CPU where the OS allows; the load average is in the note (the machine
 is shared). Rows: the whole step of ``avatargo`` with each per-tick IK
-(:data:`~synthesis.avatargo.synthesizer.SOLVERS`: the analytic Unity-IK structure, mink,
-least squares; aim: p99 under 1 ms, issue 13), and the slowest step's CPU time against the
+(:data:`~synthesis.avatargo.synthesizer.SOLVERS`: analytic, closed-form two-bone IK in place
+of the paper's Unity IK; mink; least squares; aim: p99 under 1 ms, issue 13), and the
+slowest step's CPU time against the
 90 Hz frame (a one-off hitch, such as a first tick's set-up, that p99 hides), against the
 IK baseline ``ik`` in the same process; then the parts of one AvatarGo tick, timed alone
 (best of many): the QP solvers' goals (eqs. 2-4, hands) and IK, the analytic solver's

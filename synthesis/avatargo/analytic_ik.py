@@ -1,4 +1,4 @@
-"""AvatarGo's per-tick IK as the paper's Unity IK (§3.4): closed form, no optimisation.
+"""AvatarGo's per-tick IK: closed-form two-bone IK in place of the paper's Unity IK (§3.4).
 
 §3.4 drives the avatar with Unity's built-in IK: end effectors at the wrists and ankles
 (analytic two-bone limbs), the root placed from the back tracker (eqs. 2-3), the spine
@@ -154,7 +154,8 @@ def flexion_limit(model: mujoco.MjModel, body: str, hinge: np.ndarray) -> float:
 
 
 class AnalyticIK:
-    """The paper's Unity-IK structure on ``body``'s skeleton (module docstring).
+    """Closed-form two-bone IK in place of the paper's Unity IK, on ``body``'s skeleton
+    (module docstring).
 
     The skeleton's rest pose must be the avatar's T-pose facing +X (the walk-in pose, as
     every rig :func:`~avatar_models.body.build_body` accepts), with the pelvis, spine, neck,

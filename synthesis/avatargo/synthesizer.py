@@ -20,7 +20,8 @@ Construction is the Walk-In-Avatar step (§3.2-3.3) on one T-pose sample of the 
 
 Each tick (§3.4), by the per-tick IK ``solver`` (:data:`SOLVERS`):
 
-- ``"analytic"`` (default): the paper's Unity-IK structure, no optimisation
+- ``"analytic"`` (default): closed-form two-bone IK in place of the paper's Unity IK, on its
+  effectors, no optimisation
   (:class:`~synthesis.avatargo.analytic_ik.AnalyticIK`, goals by :meth:`AvatarGo.
   analytic_goals`): the pelvis placed at its goal from the back tracker (eqs. 2-3), "the
   spine joint" turned by eq. 4's ``alpha_t`` (:func:`~synthesis.avatargo.spine.
@@ -139,10 +140,17 @@ fitted T-pose, is mink's either way (least-squares steps from there left a leg 4
 the generator's box)."""
 ANALYTIC = "analytic"
 SOLVERS = (ANALYTIC, *QP_SOLVERS)
-"""The per-tick IK: ``"analytic"`` (default), the paper's Unity-IK structure
-(:mod:`synthesis.avatargo.analytic_ik`: root from eqs. 2-3, spine by eq. 4, two-bone limbs,
-no optimisation), or one of :data:`QP_SOLVERS`, full-body IK on the humanoid standing in
-for Unity's IK."""
+"""The per-tick IK: ``"analytic"`` (default), closed-form two-bone IK written here in place
+of the paper's Unity IK, on its effectors (:mod:`synthesis.avatargo.analytic_ik`: root from
+eqs. 2-3, spine by eq. 4, two-bone limbs, no optimisation), or one of :data:`QP_SOLVERS`,
+full-body IK on the humanoid standing in for Unity's IK."""
+SOLVER_LABELS = {
+    ANALYTIC: "closed-form two-bone IK in place of the paper's Unity IK",
+    "mink": "mink full-body IK on the humanoid in place of the paper's Unity IK",
+    "least-squares": "least-squares full-body IK on the humanoid in place of the paper's Unity IK",
+}
+"""What each of :data:`SOLVERS` is, for every output that names it: none is the paper's
+implementation (Unity's built-in IK, §3.4)."""
 
 
 @dataclass(frozen=True)

@@ -1,5 +1,5 @@
-"""The analytic per-tick IK (the paper's Unity-IK structure): checked by the skeleton's own
-forward kinematics (:class:`~avatar_models.Motion`), not by the solver's."""
+"""The analytic per-tick IK (closed-form two-bone IK in place of the paper's Unity IK): checked
+by the skeleton's own forward kinematics (:class:`~avatar_models.Motion`), not by the solver's."""
 
 from __future__ import annotations
 

@@ -12,7 +12,7 @@ from avatar_models.generator import generate
 from avatar_models.generator.subject import Subject
 from render_cams.vr import Attachment
 from synthesis.avatargo.offsets import exact_offsets, fixed_offsets
-from synthesis.avatargo.study import EFFECTORS, ideal_user, reference, setup_for
+from synthesis.avatargo.study import EFFECTORS, ideal_user, setup_for
 from synthesis.avatargo.synthesizer import AvatarGo
 from synthesis.avatargo.walk_in import walk_in
 from synthesis.base import FrameBatch, on_clock
@@ -64,13 +64,13 @@ def test_exact_reconstruction_at_zero_offset_and_noise(solver):
     stream = on_clock(setup.sample(truth, seed=0))
     index = synth.device_index(FrameBatch.of_stream(stream))
     goals, _ = synth.goals(stream.positions[:, index], stream.quaternions[:, index])
-    rig_joints = truth.skeleton.indices([synth.body.rig.body17[j] for j in EFFECTORS.values()])
+    tracked = list(EFFECTORS.values())[:4]  # head, feet, root: the tracked goals
+    rig_joints = truth.skeleton.indices([synth.body.rig.body17[j] for j in tracked])
     user_joints = truth.global_positions()[:, rig_joints]
     np.testing.assert_allclose(goals[:, :4], user_joints, atol=1e-6)
-    np.testing.assert_allclose(reference(truth, user, synth), user_joints, atol=1e-9)
     out = synth.run(setup.sample(truth, seed=0))
     got = out.global_positions()[
-        :, out.skeleton.indices([synth.body.rig.body17[j] for j in EFFECTORS.values()])
+        :, out.skeleton.indices([synth.body.rig.body17[j] for j in tracked])
     ]
     err = np.linalg.norm(got - user_joints, axis=-1)  # (T, 4) head, feet, root
     assert err.max() < 1e-3
