@@ -24,7 +24,6 @@ from avatar_models import Motion
 from avatar_models.body import BodyDescription
 from render_cams.device import motion_at_rate, resolve_seed
 from render_cams.kinect.depth import BODY_INDEX_NONE, DepthFrame, KinectDepthCamera
-from render_cams.kinect.parts import paint_parts
 from render_cams.kinect.placement import (
     DEFAULT_HEIGHT_M,
     default_sensor_pose,
@@ -60,7 +59,6 @@ class DepthFrames:
     def __iter__(self) -> Iterator[DepthFrame]:
         rng = np.random.default_rng([self.seed, 1])  # the skeleton noise uses seed itself
         with BodyScene(self.body) as scene:
-            paint_parts(scene)
             for t in range(self.motion.n_frames):
                 scene.update(self.motion, t)
                 yield self.camera.capture(scene, rng)

@@ -13,17 +13,18 @@ from __future__ import annotations
 
 import hashlib
 import tomllib
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 
 import numpy as np
 
-from avatar_models.generator import generate, sample_subject
+from avatar_models.generator import ACTIVITIES, generate, sample_subject
 from avatar_models.rigs import body17_positions
 from render_cams.kinect.depth import KinectDepthCamera
 from render_cams.kinect.features import DepthFeatures, body_depth
 from render_cams.kinect.forest import from_sklearn
-from render_cams.kinect.parts import N_PARTS, paint_parts
+from render_cams.kinect.parts import N_PARTS
 from render_cams.kinect.placement import default_sensor_pose, performer_target
 from render_cams.kinect.sensors import KinectError, get_sensor
 from render_cams.kinect.tracker import BodyPartTracker
@@ -51,8 +52,17 @@ class TrackerTrainingConfig:
     def __post_init__(self) -> None:
         get_sensor(self.sensor)
         counts = (self.subjects, self.frames_per_clip, self.pixels_per_frame, self.features)
-        if min(counts) < 1 or self.trees < 1 or self.max_depth < 1 or not self.activities:
-            raise KinectError("tracker training counts must be at least 1")
+        counts += (self.trees, self.max_depth, self.min_samples_leaf)
+        if not all(isinstance(c, int) and c >= 1 for c in counts):
+            raise KinectError(f"tracker training counts must be whole numbers >= 1, got {counts}")
+        unknown = sorted(set(self.activities) - set(ACTIVITIES))
+        if not self.activities or unknown:
+            raise KinectError(f"activities must be some of {ACTIVITIES}, got {unknown or '[]'}")
+        angles = np.asarray(self.yaw_deg, float)
+        if angles.size == 0 or not np.all(np.isfinite(angles)):
+            raise KinectError(f"yaw_deg must be finite angles, got {self.yaw_deg}")
+        if not (self.seconds > 0 and self.max_offset_m > 0 and self.seed >= 0):
+            raise KinectError("seconds and max_offset_m must be positive, seed 0 or more")
 
 
 def load_training_config(path: str | Path) -> TrackerTrainingConfig:
@@ -92,20 +102,26 @@ def render_views(motion, sensor, poses, rng, noise="default"):
     ``(frame index, pose, DepthFrame)``."""
     camera_of = [KinectDepthCamera(sensor, p, noise) for p in poses]
     with BodyScene(motion.skeleton) as scene:
-        paint_parts(scene)
         for t in range(motion.n_frames):
             scene.update(motion, t)
             for pose, camera in zip(poses, camera_of, strict=True):
                 yield t, pose, camera.capture(scene, rng)
 
 
-def render_training_frames(config: TrackerTrainingConfig, subject_offset: int = 0):
+def render_training_frames(
+    config: TrackerTrainingConfig,
+    subject_offset: int = 0,
+    progress: Callable[[int, int], None] | None = None,
+):
     """``(frames, poses, joints)``: DepthFrames, their ``(4, 4)`` sensor poses and true
     body17 joints ``(17, 3)`` world, for every subject, activity, frame and yaw of
-    ``config`` (subjects ``subject_offset ...``: held-out sets use an offset)."""
+    ``config`` (subjects ``subject_offset ...``: held-out sets use an offset).
+    ``progress(clips done, clips)`` is called after each clip."""
     sensor = get_sensor(config.sensor)
     rng = np.random.default_rng([config.seed, subject_offset])
     frames, poses, joints = [], [], []
+    per_clip = config.frames_per_clip * len(config.yaw_deg)
+    n_clips = config.subjects * len(config.activities)
     for s in range(subject_offset, subject_offset + config.subjects):
         subject = sample_subject(np.random.default_rng([config.seed, s]))
         for a, activity in enumerate(config.activities):
@@ -120,6 +136,8 @@ def render_training_frames(config: TrackerTrainingConfig, subject_offset: int = 
                 frames.append(frame)
                 poses.append(pose)
                 joints.append(b17[t])
+            if progress is not None:
+                progress(len(frames) // per_clip, n_clips)
     return frames, poses, joints
 
 
@@ -170,12 +188,16 @@ def train_tracker(config: TrackerTrainingConfig, frames=None) -> BodyPartTracker
         "data_hash": data_hash(frames),
         "frames": len(frames),
         "classifier": "sklearn.ensemble.ExtraTreesClassifier",
+        "made_by": MADE_BY,
     }
     return BodyPartTracker(
         forest, push, TRACKED_SHARE * area, INFERRED_SHARE * area, draft.stride, meta=meta
     )
 
 
+MADE_BY = "avatarsim train kinect-tracker"
+"""``meta["made_by"]`` of every model :func:`train_tracker` makes: the command replaces a
+model file only when it carries this mark."""
 TRACKED_SHARE = 0.25
 """A joint is Tracked when its part's confidence reaches this share of the training median."""
 INFERRED_SHARE = 0.05
