@@ -1,6 +1,7 @@
 """The body-part label image against the body's geometry, computed here independently.
 
-The render body is posed in its T-pose (its rest pose) in front of a noise-free Kinect V2.
+The render body stands in its T-pose (its rest pose, and turned about the vertical so that
+its joints' rotations are not the identity) in front of a noise-free Kinect V2.
 Each body pixel is reprojected into the world with its depth; the test finds the nearest
 bone of the body17 stick figure (pelvis-neck, neck-head, shoulder-elbow...) and expects the
 pixel's part to be that bone's nearer end joint.
@@ -49,9 +50,9 @@ def nearest_bone_end(points: np.ndarray, joints: np.ndarray) -> np.ndarray:
     return np.where(t[np.arange(len(points)), bone] < 0.5, ends[bone, 0], ends[bone, 1])
 
 
-@pytest.fixture(scope="module")
-def frame():
-    motion = t_pose()
+@pytest.fixture(scope="module", params=[0.0, 0.7], ids=["facing", "turned"])
+def frame(request):
+    motion = t_pose(yaw=request.param)
     joints = body17_positions(motion)[0]
     eye = np.array([2.5, 0.0, 1.0])
     pose = look_at(eye, np.array([0.0, 0.0, 1.0]))
@@ -93,10 +94,11 @@ def test_labels_are_the_nearest_bone_end_of_the_stick_figure(frame):
 
 
 def test_left_parts_are_on_the_left_of_the_body(frame):
-    # The T-pose faces +X, its left is +Y: every left part's pixels have y > 0.
-    captured, camera, pose, _ = frame
+    # Every left part's pixels lie on the body's left of its midplane (r_hip -> l_hip).
+    captured, camera, pose, joints = frame
     points, parts = world_points(captured, camera, pose)
+    left = joints[INDEX["l_hip"]] - joints[INDEX["r_hip"]]
     for name in ("l_elbow", "l_wrist", "l_knee", "r_elbow", "r_wrist", "r_knee"):
-        y = points[parts == INDEX[name] + 1, 1]
-        assert y.size > 20
-        assert np.all(y > 0) if name.startswith("l_") else np.all(y < 0), name
+        side = (points[parts == INDEX[name] + 1] - joints[INDEX["pelvis"]]) @ left
+        assert side.size > 20
+        assert np.all(side > 0) if name.startswith("l_") else np.all(side < 0), name
