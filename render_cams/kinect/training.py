@@ -27,7 +27,7 @@ from render_cams.kinect.forest import from_sklearn
 from render_cams.kinect.parts import N_PARTS
 from render_cams.kinect.placement import default_sensor_pose, performer_target
 from render_cams.kinect.sensors import KinectError, get_sensor
-from render_cams.kinect.tracker import BodyPartTracker
+from render_cams.kinect.tracker import BodyPartTracker, load_tracker
 from render_cams.scene import BodyScene
 
 
@@ -86,6 +86,29 @@ def load_training_config(path: str | Path) -> TrackerTrainingConfig:
         return TrackerTrainingConfig(**data)
     except (TypeError, ValueError) as exc:
         raise KinectError(f"{path}: {exc}") from exc
+
+
+def check_model_output(path: str | Path) -> None:
+    """Before any work: ``path`` may receive a model (an ``.npz`` name, and no file there
+    but one this training wrote, which it replaces).
+
+    Raises:
+        KinectError: another name or someone else's file.
+    """
+    path = Path(path)
+    if path.suffix != ".npz":
+        raise KinectError(f"{path}: a tracker model is an .npz file; name it *.npz")
+    if not path.exists() or path.is_dir():
+        return  # a folder is refused by the caller's output checks
+    try:
+        made_by = load_tracker(path).meta.get("made_by")
+    except KinectError:
+        made_by = None
+    if made_by != MADE_BY:
+        raise KinectError(
+            f"{path} exists and is not a model this command wrote; choose another --out or "
+            "move it away"
+        )
 
 
 def orbit(pose: np.ndarray, centre: np.ndarray, yaw_rad: float) -> np.ndarray:
