@@ -11,9 +11,8 @@ from pyrender's private API is isolated in :mod:`render_cams.pyrender_patch`):
 
 - :meth:`BodyScene.render`: colour and depth, with a diffuse-only shader
   (``shaders/matte.frag``; ``shading="pbr"`` keeps pyrender's physically based one);
-- :meth:`BodyScene.render_depth_and_layers`: depth, part labels and painted vertex labels
-  (:meth:`BodyScene.paint`) from ONE flat segmentation pass (``shaders/labels.*``) that draws
-  every mesh, so labels and depth agree at every pixel.
+- :meth:`BodyScene.render_depth_and_parts`: depth and part labels from ONE flat segmentation
+  pass (``shaders/labels.*``) that draws every mesh, so labels and depth agree at every pixel.
 
 Single sampling puts every sample at the pixel centre. pyrender's default 4x multisampling
 resolves depth by taking one sample, about 0.37 px off the centre, and blends label colours
@@ -250,11 +249,12 @@ class BodyScene:
         self._merged_colours = np.c_[np.repeat(colours, sizes, axis=0), np.ones(sum(sizes))]
         labels = np.repeat(np.arange(1, len(pieces) + 1), sizes)
         self._merged_labels = np.c_[labels, np.zeros(len(labels))]  # (V, 2) texcoord_1
-        self.vertex_segments = labels - 1  # (V,) index into body.segments
         self._merged_material = pyrender.MetallicRoughnessMaterial(
             baseColorFactor=[1.0, 1.0, 1.0, 1.0], metallicFactor=0.0, roughnessFactor=0.8
         )
         self._merged_node: pyrender.Node | None = None
+        # The pose last set: global joint positions (J, 3) and rotations (J, 3, 3).
+        self.pose: tuple[np.ndarray, np.ndarray] | None = None
 
     def _add_floor(self) -> None:
         half = 10.0
@@ -264,22 +264,6 @@ class BodyScene:
             baseColorFactor=[0.55, 0.52, 0.48, 1.0], metallicFactor=0.0, roughnessFactor=1.0
         )
         self.scene.add(pyrender.Mesh.from_trimesh(floor, material=material, smooth=False))
-
-    @property
-    def body_frame_vertices(self) -> np.ndarray:
-        """``(V, 3)`` render-body vertices, each in the frame of its segment's body."""
-        return self._merged_vertices
-
-    def paint(self, labels: np.ndarray) -> None:
-        """Give every render-body vertex a painted label ``(V,)`` in 0..255 (e.g. a body
-        part), drawn by :meth:`render_depth_and_layers`; takes effect at the next pose."""
-        labels = np.asarray(labels)
-        if labels.shape != self.vertex_segments.shape or labels.min() < 0 or labels.max() > 255:
-            raise SceneError(
-                f"painted labels must be {self.vertex_segments.shape} values in 0..255, "
-                f"got {labels.shape}"
-            )
-        self._merged_labels = np.c_[self._merged_labels[:, 0], labels.astype(float)]
 
     # -- pose ---------------------------------------------------------------------------
     def set_pose(self, positions: np.ndarray, rotations: np.ndarray) -> None:
@@ -311,6 +295,7 @@ class BodyScene:
         if self._merged_node is not None:
             self.scene.remove_node(self._merged_node)
         self._merged_node = self.scene.add(pyrender.Mesh([primitive]))
+        self.pose = (positions, rotations)
 
     def update(self, motion: Motion, frame: int) -> None:
         """Pose the body as frame ``frame`` of ``motion`` (on the body's skeleton)."""
@@ -356,13 +341,12 @@ class BodyScene:
         of a pinhole camera with intrinsics ``K`` at pose ``camera_to_world`` (OpenCV axes)."""
         return self._prepare(camera_to_world, K, width, height).render(self.scene)
 
-    def render_depth_and_layers(
+    def render_depth_and_parts(
         self, camera_to_world: np.ndarray, K: np.ndarray, width: int, height: int
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Depth ``(H, W)`` float32 metres (camera z; 0 = no hit), part labels ``(H, W)``
-        int32 (0 background, ``k + 1`` segment ``k``) and painted labels ``(H, W)`` uint8
-        (:meth:`paint`; 0 off the body) from one pass: they agree at every pixel,
-        silhouettes included."""
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Depth ``(H, W)`` float32 metres (camera z; 0 = no hit) and part labels ``(H, W)``
+        int32 (0 background, ``k + 1`` segment ``k``) from one pass: they agree at every
+        pixel, silhouettes included."""
         renderer = self._prepare(camera_to_world, K, width, height)
         # pyrender's SEG pass draws only the nodes in the map: all of them, so that depth
         # covers the whole scene; meshes without per-vertex labels come out as 0.
@@ -370,13 +354,7 @@ class BodyScene:
         seg, depth = renderer.render(self.scene, pyrender.RenderFlags.SEG, every_mesh)
         labels = seg[..., 0].astype(np.int32)
         labels += seg[..., 1].astype(np.int32) << 8
-        return depth, labels, np.ascontiguousarray(seg[..., 2])
-
-    def render_depth_and_parts(
-        self, camera_to_world: np.ndarray, K: np.ndarray, width: int, height: int
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """Depth and part labels of :meth:`render_depth_and_layers`."""
-        return self.render_depth_and_layers(camera_to_world, K, width, height)[:2]
+        return depth, labels
 
     def render_parts(
         self, camera_to_world: np.ndarray, K: np.ndarray, width: int, height: int

@@ -16,6 +16,7 @@ import cv2
 import numpy as np
 
 from render_cams.kinect.noise import DepthNoiseModel
+from render_cams.kinect.parts import part_image
 from render_cams.kinect.sensors import DepthSensor, KinectError, get_sensor
 from render_cams.scene import BodyScene
 
@@ -65,24 +66,25 @@ class KinectDepthCamera:
 
     def render_clean(self, scene: BodyScene) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Noise-free ``(H, W)`` float32 depth in metres (0 = no hit, no range limit),
-        ``(H, W)`` int32 segment labels (0 background, > 0 body) and ``(H, W)`` uint8 painted
-        labels (the body parts of :func:`~render_cams.kinect.parts.paint_parts`) of the
-        scene as posed now."""
+        ``(H, W)`` int32 segment labels (0 background, > 0 body) and ``(H, W)`` uint8 body
+        parts (:func:`~render_cams.kinect.parts.part_image`) of the scene as posed now."""
         s = self.sensor
-        return scene.render_depth_and_layers(self.camera_to_world, s.K, s.width, s.height)
+        pose = self.camera_to_world
+        depth, segments = scene.render_depth_and_parts(pose, s.K, s.width, s.height)
+        return depth, segments, part_image(scene, depth, segments, s.K, pose)
 
     def capture(self, scene: BodyScene, rng: np.random.Generator) -> DepthFrame:
         """The depth frame, body-index map and part labels the sensor records of ``scene`` as
-        posed now (paint its parts first for the part labels: :func:`.parts.paint_parts`)."""
-        depth, segments, painted = self.render_clean(scene)
+        posed now."""
+        depth, segments, labelled = self.render_clean(scene)
         near, far = self.sensor.range_m
         if self.noise is None:
             measured = np.where((depth >= near) & (depth <= far), depth, np.float32(0.0))
-            body, parts = segments > 0, painted
+            body, parts = segments > 0, labelled
         else:
             measured, source = self.noise.apply(depth, self.sensor.K, (near, far), rng)
             body = segments.ravel()[source] > 0
-            parts = painted.ravel()[source].reshape(painted.shape)
+            parts = labelled.ravel()[source].reshape(labelled.shape)
         valid = body & (measured > 0)
         body_index = np.full(measured.shape, BODY_INDEX_NONE, np.uint8)
         body_index[valid] = 0

@@ -8,6 +8,11 @@ that a long take streams to disk in constant memory (a 600 s Azure Kinect take w
 20 GB). :func:`render_cams.kinect.sequence.write_kinect_recording` writes a recording to a
 folder.
 
+The skeleton (``skeleton=``): ``"tracker"`` runs the body-part tracker of
+:mod:`.tracker` on the rendered depth frames, as the SDKs do; ``"oracle-noise"`` is the
+truth-plus-noise approximation of :func:`~render_cams.kinect.skeleton.kinect_skeleton`,
+labelled as not a sensor in the stream's meta, the record and every skeleton frame.
+
 One seed drives both noises: the skeleton noise uses it as it is, the depth noise the stream
 ``[seed, 1]``.
 """
@@ -16,6 +21,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -24,14 +30,20 @@ from avatar_models import Motion
 from avatar_models.body import BodyDescription
 from render_cams.device import motion_at_rate, resolve_seed
 from render_cams.kinect.depth import BODY_INDEX_NONE, DepthFrame, KinectDepthCamera
-from render_cams.kinect.parts import paint_parts
 from render_cams.kinect.placement import (
     DEFAULT_HEIGHT_M,
     default_sensor_pose,
     performer_distance,
 )
 from render_cams.kinect.sensors import DepthSensor, KinectError, get_sensor
-from render_cams.kinect.skeleton import KinectSkeletonStream, TrackingState, kinect_skeleton
+from render_cams.kinect.skeleton import (
+    ORACLE_NOTE,
+    ORACLE_SKELETON,
+    KinectSkeletonStream,
+    TrackingState,
+    kinect_skeleton,
+)
+from render_cams.kinect.tracker import DEFAULT_MODEL, SKELETON_SOURCE, load_tracker, track
 from render_cams.scene import BodyScene, body_for_motion
 
 
@@ -60,7 +72,6 @@ class DepthFrames:
     def __iter__(self) -> Iterator[DepthFrame]:
         rng = np.random.default_rng([self.seed, 1])  # the skeleton noise uses seed itself
         with BodyScene(self.body) as scene:
-            paint_parts(scene)
             for t in range(self.motion.n_frames):
                 scene.update(self.motion, t)
                 yield self.camera.capture(scene, rng)
@@ -95,6 +106,10 @@ class KinectRecording:
     record: dict[str, Any]
 
 
+SKELETONS = (SKELETON_SOURCE, ORACLE_SKELETON)
+"""What the ``Kinect`` device's skeleton comes from: the depth tracker or the oracle."""
+
+
 @dataclass(frozen=True, eq=False)
 class Kinect:
     """A Kinect and where it stands.
@@ -107,7 +122,10 @@ class Kinect:
             performer, the whole take in range and view where the range allows) at
             ``sensor_height_m`` above the floor.
         max_frames: record at most this many frames (from the start).
-        depth_noise, skeleton_noise: ``"default"``, a model, or ``None`` for clean output.
+        depth_noise, skeleton_noise: ``"default"``, a model, or ``None`` for clean output
+            (``skeleton_noise`` is the oracle's).
+        skeleton: :data:`SKELETONS`: ``"tracker"`` (from the depth) or ``"oracle-noise"``.
+        tracker_model: the tracker's ``.npz`` model; None: the shipped one.
     """
 
     sensor: str | DepthSensor = "kinect-v2"
@@ -116,9 +134,13 @@ class Kinect:
     max_frames: int | None = None
     depth_noise: Any = "default"
     skeleton_noise: Any = "default"
+    skeleton: str = ORACLE_SKELETON
+    tracker_model: str | Path | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "sensor", get_sensor(self.sensor))
+        if self.skeleton not in SKELETONS:
+            raise KinectError(f"skeleton must be one of {SKELETONS}, got {self.skeleton!r}")
         if self.max_frames is not None and self.max_frames < 1:
             raise KinectError(f"max_frames must be at least 1, got {self.max_frames}")
 
@@ -154,10 +176,14 @@ class Kinect:
             else np.asarray(self.sensor_pose, float)
         )
         used_seed = resolve_seed(seed)
-        skeleton = kinect_skeleton(sampled, sensor, pose, used_seed, self.skeleton_noise, body)
         frames = DepthFrames(
             sampled, body, KinectDepthCamera(sensor, pose, self.depth_noise), used_seed
         )
+        if self.skeleton == SKELETON_SOURCE:
+            model = DEFAULT_MODEL if self.tracker_model is None else self.tracker_model
+            skeleton = track(frames, sensor, pose, load_tracker(model))
+        else:
+            skeleton = kinect_skeleton(sampled, sensor, pose, used_seed, self.skeleton_noise, body)
         states = skeleton.states
         record = {
             "device": sensor.name,
@@ -179,6 +205,8 @@ class Kinect:
             "rig": skeleton.rig,
             "joint_names": list(skeleton.joint_names),
             "seed": used_seed,
+            "skeleton": skeleton.meta["skeleton"],
+            **({"skeleton_note": ORACLE_NOTE} if self.skeleton == ORACLE_SKELETON else {}),
             "depth_unit": "mm",
             "body_index_none": BODY_INDEX_NONE,
         }

@@ -11,12 +11,14 @@ trees); the class distribution is the mean of its leaves'.
 from __future__ import annotations
 
 import json
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from avatar_models.fileio import atomic_file
 from render_cams.kinect.features import DepthFeatures
 from render_cams.kinect.sensors import KinectError
 
@@ -71,21 +73,23 @@ class Forest:
         return probs / len(self.roots)
 
     def save(self, path: str | Path, meta: dict[str, Any]) -> Path:
-        """Write the forest and ``meta`` (JSON-ready: config, seed, data hash...) to ``path``."""
+        """Write the forest and ``meta`` (JSON-ready: config, seed, data hash...) to ``path``
+        atomically (the whole file or nothing)."""
         path = Path(path)
-        np.savez_compressed(
-            path,
-            u=self.features.u.astype(np.float32),
-            v=self.features.v.astype(np.float32),
-            roots=self.roots.astype(np.int32),
-            feature=self.feature.astype(np.int16),
-            threshold=self.threshold.astype(np.float32),
-            left=self.left.astype(np.int32),
-            right=self.right.astype(np.int32),
-            leaf_probs=np.rint(self.leaf_probs * 255).astype(np.uint8),
-            depth=np.int32(self.depth),
-            meta=np.array(json.dumps(meta, sort_keys=True)),
-        )
+        with atomic_file(path) as fh:
+            np.savez_compressed(
+                fh,
+                u=self.features.u.astype(np.float32),
+                v=self.features.v.astype(np.float32),
+                roots=self.roots.astype(np.int32),
+                feature=self.feature.astype(np.int16),
+                threshold=self.threshold.astype(np.float32),
+                left=self.left.astype(np.int32),
+                right=self.right.astype(np.int32),
+                leaf_probs=np.rint(self.leaf_probs * 255).astype(np.uint8),
+                depth=np.int32(self.depth),
+                meta=np.array(json.dumps(meta, sort_keys=True)),
+            )
         return path
 
 
@@ -109,7 +113,7 @@ def load_forest(path: str | Path) -> tuple[Forest, dict[str, Any]]:
                 int(z["depth"]),
             )
             meta = json.loads(str(z["meta"]))
-    except (OSError, KeyError, ValueError) as exc:
+    except (OSError, KeyError, ValueError, IndexError, TypeError, zipfile.BadZipFile) as exc:
         raise KinectError(f"{path}: not a Kinect tracker model ({exc})") from exc
     return forest, meta
 

@@ -2,7 +2,9 @@
 
 Shotton et al. (CVPR 2011, section 4, eq. 6) find joint proposals as the modes of the density
 ``f(x) = sum_i w_i exp(-||(x - x_i) / b||^2)`` of a part's pixels reprojected into the world,
-by mean shift (Comaniciu and Meer 2002). Every seed climbs to its mode; the mode with the
+by mean shift (Comaniciu and Meer 2002). Seeds are the weighted centres of the heaviest cells
+of a grid one bandwidth wide (scikit-learn's ``bin_seeding``), so every cluster of weight gets
+a seed whatever the order of the points; every seed climbs to its mode, the mode with the
 highest density wins, and the weight within one bandwidth of it is its confidence.
 """
 
@@ -18,11 +20,9 @@ def densest_mode(
     points: np.ndarray, weights: np.ndarray, bandwidth_m: float, n_seeds: int = 24
 ) -> tuple[np.ndarray, float]:
     """The densest mode ``(3,)`` of ``points (N, 3)`` weighted by ``weights (N,)`` (N >= 1)
-    and the total weight of the points within ``bandwidth_m`` of it.
-
-    Seeds are the ``n_seeds`` heaviest points (ties in input order)."""
-    order = np.argsort(-weights, kind="stable")[:n_seeds]
-    modes = points[order]
+    and the total weight of the points within ``bandwidth_m`` of it; seeds from the
+    ``n_seeds`` heaviest grid cells."""
+    modes = _cell_seeds(points, weights, bandwidth_m, n_seeds)
     scale = -1.0 / bandwidth_m**2
     for _ in range(ITERATIONS):
         kernel = np.exp(scale * _squared_distances(modes, points)) * weights  # (S, N)
@@ -31,6 +31,16 @@ def densest_mode(
     best = modes[int(np.argmax(density))]
     near = np.sum((points - best) ** 2, axis=1) <= bandwidth_m**2
     return best, float(weights[near].sum())
+
+
+def _cell_seeds(points, weights, size_m: float, n_seeds: int) -> np.ndarray:
+    """``(S, 3)`` weighted centres of the ``S <= n_seeds`` heaviest cells of side ``size_m``."""
+    _, cell = np.unique(np.floor(points / size_m).astype(np.int64), axis=0, return_inverse=True)
+    cell = cell.ravel()
+    total = np.bincount(cell, weights)
+    centres = np.stack([np.bincount(cell, weights * p) for p in points.T], 1)
+    heaviest = np.argsort(-total, kind="stable")[:n_seeds]
+    return centres[heaviest] / np.maximum(total[heaviest, None], 1e-300)
 
 
 def _squared_distances(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""The body-part set of the Kinect tracker: one part around each body17 joint.
+"""The body-part set of the Kinect tracker and its per-pixel label image.
 
 Shotton et al. (CVPR 2011, section 2.2) paint 31 parts on their synthetic bodies, some
 "defined to directly localise particular skeletal joints of interest" (elbow, wrist, knee,
@@ -9,10 +9,14 @@ body. 17 parts instead of 31 because every joint the tracker reports is built fr
 joints (:mod:`.rig_joints`), so a part between two joints would only be a class to tell apart,
 with fewer training pixels per class, that yields no proposal.
 
-Each vertex of the render body takes the part of the nearest (rest pose) body17 joint among
-those its segment may touch (:data:`CANDIDATES`: a forearm vertex belongs to the elbow or the
-wrist, never to the hip it passes in an arms-down rest pose), so parts are painted on the
-surface and move with it, as in Shotton's renders.
+A body point takes the part of the nearest (rest pose) body17 joint among those its segment
+may touch (:data:`CANDIDATES`: a forearm point belongs to the elbow or the wrist, never to
+the hip it passes in an arms-down rest pose), so parts are fixed on the surface and move with
+it, as in Shotton's renders. The label image is computed per pixel (:func:`part_image`):
+each body pixel of a clean render is reprojected with its depth, carried back into its
+segment's rest frame, and labelled there. Painting labels on mesh vertices instead would
+follow the tessellation: a capsule's flat sides are single triangles from joint to joint,
+and a flat-shaded triangle takes one vertex's label.
 """
 
 from __future__ import annotations
@@ -58,27 +62,59 @@ def segment_candidates(kind: str, side: str) -> np.ndarray:
     return np.array([INDEX[n] for n in names])
 
 
-def vertex_parts(body: BodyDescription, vertices: np.ndarray, segment: np.ndarray) -> np.ndarray:
-    """``(V,)`` uint8 part labels (1..17) of render-body vertices.
+def candidate_table(body: BodyDescription) -> np.ndarray:
+    """``(S, C)`` body17 candidates of each of ``body``'s ``S`` segments, padded with -1."""
+    rows = [segment_candidates(s.kind, s.side) for s in body.segments]
+    table = np.full((len(rows), max(len(r) for r in rows)), -1)
+    for k, r in enumerate(rows):
+        table[k, : len(r)] = r
+    return table
+
+
+def rest_parts(body: BodyDescription, rest_points: np.ndarray, segment: np.ndarray) -> np.ndarray:
+    """``(N,)`` uint8 part labels (1..17) of body points.
 
     Args:
-        vertices: ``(V, 3)`` positions in the frame of each vertex's segment body.
-        segment: ``(V,)`` index into ``body.segments`` of each vertex.
+        rest_points: ``(N, 3)`` positions in the rest pose (root joint at the origin).
+        segment: ``(N,)`` index into ``body.segments`` of each point's segment.
     """
     skeleton = body.skeleton
     rest = skeleton.rest_positions()
     b17_rest = rest[identify_rig(skeleton).body17_indices(skeleton)]  # (17, 3)
-    bodies = np.array([s.body for s in body.segments])
-    world = vertices + rest[bodies[segment]]  # rest rotations are the identity
-    labels = np.empty(len(vertices), np.uint8)
-    for k, seg in enumerate(body.segments):
-        mine = segment == k
-        allowed = segment_candidates(seg.kind, seg.side)
-        dist = np.linalg.norm(world[mine, None] - b17_rest[allowed], axis=-1)
-        labels[mine] = allowed[np.argmin(dist, axis=1)] + 1
+    candidates = candidate_table(body)[segment]  # (N, C)
+    dist = np.linalg.norm(rest_points[:, None] - b17_rest[candidates], axis=-1)
+    dist[candidates < 0] = np.inf
+    best = candidates[np.arange(len(segment)), np.argmin(dist, axis=1)]
+    return (best + 1).astype(np.uint8)
+
+
+def part_image(
+    scene: BodyScene,
+    depth: np.ndarray,
+    segments: np.ndarray,
+    K: np.ndarray,
+    camera_to_world: np.ndarray,
+) -> np.ndarray:
+    """``(H, W)`` uint8 part labels (:data:`PART_NONE` off the body) of a clean render of
+    ``scene`` as posed now.
+
+    Args:
+        depth: ``(H, W)`` camera-z metres of the render.
+        segments: ``(H, W)`` its segment labels (0 background, ``k + 1`` segment ``k``;
+            :meth:`BodyScene.render_depth_and_parts`).
+        K: ``(3, 3)`` intrinsics; camera_to_world: ``(4, 4)`` pose (OpenCV axes).
+    """
+    labels = np.zeros(depth.shape, np.uint8)
+    rows, cols = np.nonzero(segments > 0)
+    if rows.size == 0:
+        return labels
+    d = depth[rows, cols].astype(float)
+    cam = np.stack([(cols - K[0, 2]) / K[0, 0] * d, (rows - K[1, 2]) / K[1, 1] * d, d], 1)
+    world = cam @ camera_to_world[:3, :3].T + camera_to_world[:3, 3]
+    positions, rotations = scene.pose
+    segment = segments[rows, cols] - 1
+    joint = scene.part_bodies[segment]
+    local = np.einsum("nji,nj->ni", rotations[joint], world - positions[joint])  # R^T (p - x)
+    rest = scene.body.skeleton.rest_positions()
+    labels[rows, cols] = rest_parts(scene.body, local + rest[joint], segment)
     return labels
-
-
-def paint_parts(scene: BodyScene) -> None:
-    """Paint ``scene``'s body with these parts (:meth:`BodyScene.paint`)."""
-    scene.paint(vertex_parts(scene.body, scene.body_frame_vertices, scene.vertex_segments))

@@ -147,7 +147,12 @@ def _torso_frames(b17: np.ndarray) -> np.ndarray:
 
 def _shortest_rotation(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     """``(..., 3, 3)`` smallest rotation taking direction ``u`` to ``v`` (Rodrigues); a half
-    turn about an axis perpendicular to ``u`` when they are opposite."""
+    turn about an axis perpendicular to ``u`` when they are opposite; NaN where ``u`` or
+    ``v`` is not finite (a joint a tracker did not find)."""
+    u, v = np.broadcast_arrays(u, v)
+    lost = ~np.all(np.isfinite(u) & np.isfinite(v), axis=-1)
+    u = np.where(lost[..., None], [1.0, 0.0, 0.0], u)
+    v = np.where(lost[..., None], [1.0, 0.0, 0.0], v)
     u = u / np.linalg.norm(u, axis=-1, keepdims=True)
     v = v / np.linalg.norm(v, axis=-1, keepdims=True)
     axis = np.cross(u, v)
@@ -157,7 +162,9 @@ def _shortest_rotation(u: np.ndarray, v: np.ndarray) -> np.ndarray:
     axis = np.where((sin < 1e-9)[..., None], fallback, axis)
     axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
     angle = np.arctan2(sin, cos)
-    return quat.to_matrix(quat.from_axis_angle(axis, angle))
+    return np.where(
+        lost[..., None, None], np.nan, quat.to_matrix(quat.from_axis_angle(axis, angle))
+    )
 
 
 def _swing_orientations(positions: np.ndarray, rest: np.ndarray, parents) -> np.ndarray:
@@ -170,7 +177,10 @@ def _swing_orientations(positions: np.ndarray, rest: np.ndarray, parents) -> np.
     end[0] = first_child
     rest_bones = rest[end] - rest[start]
     bones = positions[:, end] - positions[:, start]
-    return quat.from_matrix(_shortest_rotation(np.broadcast_to(rest_bones, bones.shape), bones))
+    swing = _shortest_rotation(np.broadcast_to(rest_bones, bones.shape), bones)
+    lost = np.isnan(swing[..., 0, 0])
+    swing[lost] = np.eye(3)
+    return np.where(lost[..., None], np.nan, quat.from_matrix(swing))
 
 
 def rig_joints_from_body17(b17: np.ndarray, rig: Rig) -> tuple[np.ndarray, np.ndarray]:

@@ -64,6 +64,15 @@ class SkeletonNoise:
             raise KinectError(f"skeleton noise parameters must be non-negative, got {values}")
 
 
+ORACLE_SKELETON = "oracle-noise"
+"""``meta["skeleton"]`` of :func:`kinect_skeleton` streams: the true joints plus noise, a
+fast approximation that never looks at the depth, so not a sensor's output."""
+ORACLE_NOTE = (
+    "not a sensor: the true joints of the simulated body plus AR(1) Gaussian noise, "
+    "tracking state from geometry; no depth was tracked"
+)
+"""``meta["skeleton_note"]`` of those streams, carried into every output that holds one."""
+
 NOISE_BY_RIG = {"kinect_v2": SkeletonNoise(), "azure_kinect": SkeletonNoise(tracked_m=0.01)}
 
 
@@ -118,6 +127,7 @@ class KinectSkeletonStream:
         return {
             "timestamp_s": float(self.timestamps[t]),
             "rig": self.rig,
+            "skeleton": self.meta.get("skeleton"),
             "body_tracked": bool(np.any(states != TrackingState.NOT_TRACKED)),
             "joints": [
                 {
@@ -145,7 +155,9 @@ def kinect_skeleton(
     noise: SkeletonNoise | None | str = "default",
     body: BodyDescription | None = None,
 ) -> KinectSkeletonStream:
-    """The skeleton stream a Kinect at ``sensor_pose`` reports for ``motion`` at 30 Hz.
+    """The skeleton stream a Kinect at ``sensor_pose`` would report for ``motion`` at 30 Hz,
+    approximated from the truth (``meta["skeleton"] = "oracle-noise"``, not a sensor: the
+    depth tracker is :func:`render_cams.kinect.tracker.track`).
 
     Args:
         motion: any motion whose rig has a body17 map.
@@ -194,6 +206,8 @@ def kinect_skeleton(
             "rate_hz": sensor.rate_hz,
             "seed": used_seed,
             "noise": None if model is None else model.__dict__,
+            "skeleton": ORACLE_SKELETON,
+            "skeleton_note": ORACLE_NOTE,
         },
     )
 

@@ -34,7 +34,7 @@ MODELS = Path(__file__).with_name("models")
 DEFAULT_MODEL = MODELS / "kinect-tracker.npz"
 """The shipped forest, made by ``avatarsim train kinect-tracker`` (its config and seed are in
 the file's metadata)."""
-SKELETON_SOURCE = "depth-tracker"
+SKELETON_SOURCE = "tracker"
 """``meta["skeleton"]`` of streams made by this tracker (the oracle is ``"oracle-noise"``)."""
 
 

@@ -12,22 +12,23 @@ thresholds) on the same frames. Deterministic for a config and seed.
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
 
 from avatar_models.config import ConfigError, load_toml, setting
-from avatar_models.generator import generate, sample_subject
+from avatar_models.generator import ACTIVITIES, generate, sample_subject
 from avatar_models.memory import require_memory
 from avatar_models.rigs import body17_positions
 from render_cams.kinect.depth import KinectDepthCamera
 from render_cams.kinect.features import DepthFeatures, body_depth
 from render_cams.kinect.forest import from_sklearn
-from render_cams.kinect.parts import N_PARTS, paint_parts
+from render_cams.kinect.parts import N_PARTS
 from render_cams.kinect.placement import default_sensor_pose, performer_target
-from render_cams.kinect.sensors import SENSORS, get_sensor
-from render_cams.kinect.tracker import BodyPartTracker
+from render_cams.kinect.sensors import SENSORS, KinectError, get_sensor
+from render_cams.kinect.tracker import BodyPartTracker, load_tracker
 from render_cams.scene import BodyScene
 
 
@@ -74,8 +75,34 @@ def load_training_config(path: str | Path) -> TrackerTrainingConfig:
         raise ConfigError(
             f"{path}: sensor must be one of {', '.join(SENSORS)}, got {config.sensor!r}"
         )
+    unknown = sorted(set(config.activities) - set(ACTIVITIES))
+    if unknown:
+        raise ConfigError(f"{path}: activities must be some of {ACTIVITIES}, got {unknown}")
     require_memory(config.memory_bytes(), f"{path}: the tracker's training frames")
     return config
+
+
+def check_model_output(path: str | Path) -> None:
+    """Before any work: ``path`` may receive a model (an ``.npz`` name, and no file there
+    but one this training wrote, which it replaces).
+
+    Raises:
+        KinectError: another name or someone else's file.
+    """
+    path = Path(path)
+    if path.suffix != ".npz":
+        raise KinectError(f"{path}: a tracker model is an .npz file; name it *.npz")
+    if not path.exists() or path.is_dir():
+        return  # a folder is refused by the caller's output checks
+    try:
+        made_by = load_tracker(path).meta.get("made_by")
+    except KinectError:
+        made_by = None
+    if made_by != MADE_BY:
+        raise KinectError(
+            f"{path} exists and is not a model this command wrote; choose another --out or "
+            "move it away"
+        )
 
 
 def orbit(pose: np.ndarray, centre: np.ndarray, yaw_rad: float) -> np.ndarray:
@@ -92,20 +119,26 @@ def render_views(motion, sensor, poses, rng, noise="default"):
     ``(frame index, pose, DepthFrame)``."""
     camera_of = [KinectDepthCamera(sensor, p, noise) for p in poses]
     with BodyScene(motion.skeleton) as scene:
-        paint_parts(scene)
         for t in range(motion.n_frames):
             scene.update(motion, t)
             for pose, camera in zip(poses, camera_of, strict=True):
                 yield t, pose, camera.capture(scene, rng)
 
 
-def render_training_frames(config: TrackerTrainingConfig, subject_offset: int = 0):
+def render_training_frames(
+    config: TrackerTrainingConfig,
+    subject_offset: int = 0,
+    progress: Callable[[int, int], None] | None = None,
+):
     """``(frames, poses, joints)``: DepthFrames, their ``(4, 4)`` sensor poses and true
     body17 joints ``(17, 3)`` world, for every subject, activity, frame and yaw of
-    ``config`` (subjects ``subject_offset ...``: held-out sets use an offset)."""
+    ``config`` (subjects ``subject_offset ...``: held-out sets use an offset).
+    ``progress(clips done, clips)`` is called after each clip."""
     sensor = get_sensor(config.sensor)
     rng = np.random.default_rng([config.seed, subject_offset])
     frames, poses, joints = [], [], []
+    per_clip = config.frames_per_clip * len(config.yaw_deg)
+    n_clips = config.subjects * len(config.activities)
     for s in range(subject_offset, subject_offset + config.subjects):
         subject = sample_subject(np.random.default_rng([config.seed, s]))
         for a, activity in enumerate(config.activities):
@@ -120,6 +153,8 @@ def render_training_frames(config: TrackerTrainingConfig, subject_offset: int = 
                 frames.append(frame)
                 poses.append(pose)
                 joints.append(b17[t])
+            if progress is not None:
+                progress(len(frames) // per_clip, n_clips)
     return frames, poses, joints
 
 
@@ -170,12 +205,16 @@ def train_tracker(config: TrackerTrainingConfig, frames=None) -> BodyPartTracker
         "data_hash": data_hash(frames),
         "frames": len(frames),
         "classifier": "sklearn.ensemble.ExtraTreesClassifier",
+        "made_by": MADE_BY,
     }
     return BodyPartTracker(
         forest, push, TRACKED_SHARE * area, INFERRED_SHARE * area, draft.stride, meta=meta
     )
 
 
+MADE_BY = "avatarsim train kinect-tracker"
+"""``meta["made_by"]`` of every model :func:`train_tracker` makes: the command replaces a
+model file only when it carries this mark."""
 TRACKED_SHARE = 0.25
 """A joint is Tracked when its part's confidence reaches this share of the training median."""
 INFERRED_SHARE = 0.05

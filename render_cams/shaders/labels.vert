@@ -1,7 +1,6 @@
 #version 330 core
 // Segmentation pass of BodyScene (replaces pyrender's segmentation.vert): the merged body
-// carries each vertex's part label in texcoord_1.x and a painted label in
-// texcoord_1.y; meshes without one are label 0. The
+// carries each vertex's part label in texcoord_1.x; meshes without one are label 0. The
 // label is passed "flat" (not interpolated) so that every pixel holds an exact label.
 layout(location = 0) in vec3 position;
 #ifdef TEXCOORD_1_LOC
@@ -20,9 +19,8 @@ void main()
     gl_Position = P * V * M * inst_m * vec4(position, 1.0);
 #ifdef TEXCOORD_1_LOC
     float label = texcoord_1.x;
-    // Low byte in red, high byte in green, the painted label (texcoord_1.y) in blue, as
-    // unorm8 values that round-trip exactly.
-    label_colour = vec3(mod(label, 256.0), floor(label / 256.0), texcoord_1.y) / 255.0;
+    // Low byte in red, high byte in green, as unorm8 values that round-trip exactly.
+    label_colour = vec3(mod(label, 256.0), floor(label / 256.0), 0.0) / 255.0;
 #else
     label_colour = vec3(0.0);
 #endif
