@@ -10,9 +10,9 @@ import pytest
 from typer.testing import CliRunner
 
 from avatar_models.formats import load_motion
-from scripts.cli import app
 from avatar_models.generator import Subject, generate
 from render_cams import VRSetup
+from scripts.cli import app
 from scripts.leaderboard import (
     COLUMNS,
     run_leaderboard,
@@ -66,11 +66,13 @@ def test_leaderboard_on_a_small_builtin_set(tmp_path):
 
 def test_each_physics_column_is_its_own_check_run_alone():
     """A leaderboard row's physics columns, each against the one check that defines it run
-    by itself on the same output (a walk 4 cm into the floor, so that penetration, skating,
-    joint limits and residual forces all differ)."""
+    by itself on the same output (a walk sunk 4 cm into the floor, so that penetration
+    differs from every other column)."""
     motion = generate("walk", Subject(height_m=1.75), 1.0, 90.0, seed=2)
     sunk = motion.replace(root_pos=motion.root_pos - [0.0, 0.0, 0.04])
-    result = score_method(TruthReplay(sunk), sunk, VRSetup().sample(sunk, seed=0), CheckConfig())
+    result = score_method(
+        TruthReplay(sunk), sunk, VRSetup().sample(sunk, seed=0), CheckConfig(), time_steps=True
+    )
     row = trial_row(result)
     own_check = {
         "penetration_cm_p95": PenetrationCheck(),
@@ -82,7 +84,10 @@ def test_each_physics_column_is_its_own_check_run_alone():
         key: check_humanoid(result.humanoid, checks=[check]).values[key]
         for key, check in own_check.items()
     }
-    assert len(set(alone.values())) == len(alone), alone  # the columns can tell them apart
+    pen = alone.pop("penetration_cm_p95")
+    assert pen == pytest.approx(4.0, abs=0.05)  # the depth it was sunk by
+    assert pen not in alone.values(), alone  # no other column could pass as penetration
+    alone["penetration_cm_p95"] = pen
     assert {key: row[key] for key in own_check} == pytest.approx(alone, rel=1e-9), alone
 
 

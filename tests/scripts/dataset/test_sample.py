@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from avatar_models.body17 import INDEX
-from avatar_models.rigs import body17_positions
 from avatar_models.generator import Subject, generate
+from avatar_models.rigs import body17_positions
 from scripts.dataset.channels import kinect_channel, physics_channel
 from scripts.dataset.config import config_hash, from_dict
 from scripts.dataset.plan import plan_samples
@@ -91,10 +91,11 @@ def test_kinect_positions_follow_the_body_along_the_world_axes(wave):
     assert tracked.mean() > 0.5
     shift = (there["kinect_pos"] - here["kinect_pos"])[tracked]  # (n, 3)
     np.testing.assert_allclose(np.median(shift, axis=0), [0.8, -0.3, 0.0], atol=0.01)
-    # The Kinect's head (joint 3 of the Kinect V2's 25) on the moved body's head, per axis.
-    head = body17_positions(moved_humanoid.motion)[:, INDEX["head"]]
-    gap = np.abs(there["kinect_pos"][:, 3] - head)[there["kinect_state"][:, 3] == 2]
-    assert np.all(np.median(gap, axis=0) < 0.1), np.median(gap, axis=0)
+    # The Kinect's head (joint 3 of the Kinect V2's 25) over the moved body's head: within
+    # 5 cm along X and Y (the two joints are different points of the head, ~10 cm apart in Z).
+    head = body17_positions(moved_humanoid.motion)[:, INDEX["head"], :2]
+    gap = np.abs(there["kinect_pos"][:, 3, :2] - head)[there["kinect_state"][:, 3] == 2]
+    assert np.all(np.median(gap, axis=0) < 0.05), np.median(gap, axis=0)
 
 
 def test_provenance(first_sample):
