@@ -7,7 +7,7 @@ TORCH := 2.13.0
 MEDIAPIPE := 0.10.21
 OUT ?= out/demo
 
-.PHONY: demo test lint bench clean lock
+.PHONY: demo test test-slow lint bench clean lock
 
 # Every resolved version is pinned in requirements.lock (`make lock` refreshes it). The lock
 # is installed with --no-deps, so nothing outside it comes in, and `pip check` proves it is
@@ -63,6 +63,11 @@ lint: $(STAMP)
 
 test: lint
 	$(BIN)/python -m pytest -q -n 2 --dist loadfile
+
+# The slow tier (`-m slow`, deselected by `make test`): the 10 s searched walks, the 20-shard
+# kill -9 resume and the leaderboard on real clips; about 17 min of CPU (README).
+test-slow: $(STAMP)
+	$(BIN)/python -m pytest -q -n 2 --dist loadfile -m slow --durations=0
 
 bench: $(STAMP)
 	$(BIN)/avatarsim bench $(if $(wildcard ../shared/mocap),--mocap ../shared/mocap)

@@ -4,7 +4,11 @@ A shard is a plain POSIX (ustar) tar: each sample's entries ``<key>.<name>.npy``
 array, ``numpy.save`` format), ``<key>.<name>`` for an encoded image (bytes whose name ends
 ``.jpg`` or ``.png``) then ``<key>.json``, samples in plan order, entries of a sample
 sorted by name. WebDataset groups consecutive entries by the key before the first dot, so
-``webdataset.WebDataset(url)`` reads these shards as they are. Every header field that could
+``webdataset.WebDataset(url)`` reads these shards as they are; its sample dicts keep each
+entry's suffix (``body17.npy``). Decode them with :func:`decode_entry`
+(``WebDataset(url).decode(decode_entry)``): webdataset's own image decoders turn the 16-bit
+depth PNGs into 8-bit or normalised floats, while this one keeps them uint16 millimetres, and
+gives every entry the array :func:`read_samples` gives. Every header field that could
 vary between runs is fixed (mtime 0, uid/gid 0, no user or group name, mode 0644), and the
 JSON is written with sorted keys, so the same samples always give the same bytes.
 """
@@ -78,20 +82,27 @@ def decode_image(data: bytes) -> np.ndarray:
     return image[..., ::-1].copy() if image.ndim == 3 else image
 
 
+def decode_entry(name: str, data: bytes) -> np.ndarray | dict[str, Any] | None:
+    """One entry of a sample by its name after the key (``body17.npy``,
+    ``kinect_depth.0000.png``, ``json``; a leading dot, as webdataset's ``Decoder`` passes
+    it, is allowed): ``.npy`` as its array, ``.jpg``/``.png`` as :func:`decode_image` (depth
+    stays uint16 mm), ``json`` as a dict; ``None`` for any other name, which a webdataset
+    decoder then hands to its next handler."""
+    if name.endswith("json"):
+        return json.loads(data)
+    if name.endswith(IMAGE_EXTENSIONS):
+        return decode_image(data)
+    if name.endswith(".npy"):
+        return np.load(io.BytesIO(data), allow_pickle=False)
+    return None
+
+
 def sha256_file(path: Path) -> str:
     digest = hashlib.sha256()
     with open(path, "rb") as fh:
         for block in iter(lambda: fh.read(1 << 20), b""):
             digest.update(block)
     return digest.hexdigest()
-
-
-def _decode(ext: str, data: bytes) -> Any:
-    if ext == "json":
-        return json.loads(data)
-    if ext.endswith(IMAGE_EXTENSIONS):
-        return decode_image(data)
-    return np.load(io.BytesIO(data), allow_pickle=False)
 
 
 def read_samples(path: Path) -> Iterator[tuple[str, dict[str, Any]]]:
@@ -119,7 +130,10 @@ def read_samples(path: Path) -> Iterator[tuple[str, dict[str, Any]]]:
                 data = tar.extractfile(member).read() if member.isfile() else None
                 if data is None:
                     raise ValueError("not a file entry")
-                sample["json" if ext == "json" else ext.removesuffix(".npy")] = _decode(ext, data)
+                value = decode_entry(ext, data)
+                if value is None:
+                    raise ValueError("an entry of no known kind (.npy, .json, image)")
+                sample[ext.removesuffix(".npy")] = value
         except (tarfile.TarError, EOFError, OSError, ValueError) as exc:
             where = f"entry {name!r}" if name is not None else "its first entry"
             raise ShardError(f"{path}: {where} is damaged ({exc})") from None

@@ -73,7 +73,6 @@ def test_arms_sweep_the_sixteen_spheres_of_the_study_volume(sweep):
     assert np.mean(speed[speed > 0.05]) == pytest.approx(1.1, abs=0.15)  # measured 1.07-1.10
 
 
-@pytest.mark.slow
 def test_every_study_pose_is_physically_plausible(poses):
     for name, seed in poses.items():
         report = check_motion(generate(ACTIVITY, duration_s=3.0, seed=seed))

@@ -10,11 +10,27 @@ import pytest
 from typer.testing import CliRunner
 
 from avatar_models.formats import load_motion
+from avatar_models.generator import Subject, generate
+from render_cams import VRSetup
 from scripts.cli import app
-from scripts.leaderboard import COLUMNS, run_leaderboard, tracked_notes, tracked_summary
+from scripts.leaderboard import (
+    COLUMNS,
+    run_leaderboard,
+    tracked_notes,
+    tracked_summary,
+    trial_row,
+)
+from scripts.method_score import score_method
+from sim.checks.joint_limits import JointLimitCheck
+from sim.checks.penetration import PenetrationCheck
+from sim.checks.residual import ResidualForceCheck
+from sim.checks.skating import SkatingCheck
+from sim.plausibility import check_humanoid
+from sim.thresholds import CheckConfig
 from synthesis.evaluate import Trial
 from synthesis.methods import METHODS, ready_methods
 from tests.conftest import require
+from tests.synthesis.conftest import TruthReplay
 
 runner = CliRunner()
 
@@ -46,6 +62,33 @@ def test_leaderboard_on_a_small_builtin_set(tmp_path):
     kinect = board["sensor_tracked"]["kinect"]
     assert "movebox" in kinect["methods"] and 0.0 <= kinect["mean"] <= 1.0
     assert "kinect: every body17 joint tracked in" in page
+
+
+def test_each_physics_column_is_its_own_check_run_alone():
+    """A leaderboard row's physics columns, each against the one check that defines it run
+    by itself on the same output (a walk sunk 4 cm into the floor, so that penetration
+    differs from every other column)."""
+    motion = generate("walk", Subject(height_m=1.75), 1.0, 90.0, seed=2)
+    sunk = motion.replace(root_pos=motion.root_pos - [0.0, 0.0, 0.04])
+    result = score_method(
+        TruthReplay(sunk), sunk, VRSetup().sample(sunk, seed=0), CheckConfig(), time_steps=True
+    )
+    row = trial_row(result)
+    own_check = {
+        "penetration_cm_p95": PenetrationCheck(),
+        "skate_cm_s_median": SkatingCheck(),
+        "joint_limit_violation_frac": JointLimitCheck(),
+        "residual_force_bw_p95": ResidualForceCheck(),
+    }
+    alone = {
+        key: check_humanoid(result.humanoid, checks=[check]).values[key]
+        for key, check in own_check.items()
+    }
+    pen = alone.pop("penetration_cm_p95")
+    assert pen == pytest.approx(4.0, abs=0.05)  # the depth it was sunk by
+    assert pen not in alone.values(), alone  # no other column could pass as penetration
+    alone["penetration_cm_p95"] = pen
+    assert {key: row[key] for key in own_check} == pytest.approx(alone, rel=1e-9), alone
 
 
 def test_tracked_share_is_averaged_per_class_then_over_classes():

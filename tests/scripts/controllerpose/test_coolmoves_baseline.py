@@ -55,7 +55,6 @@ def truth_world_head(root, examples) -> np.ndarray:
 
 
 @pytest.mark.mocap
-@pytest.mark.slow
 @pytest.mark.parametrize("source", sorted(SOURCES))
 def test_coolmoves_baseline_on_a_real_clip(source, mocap_dir, database):
     clips, streams = mocap_examples(mocap_dir / SOURCES[source], 1, 1.0)

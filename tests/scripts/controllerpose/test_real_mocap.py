@@ -26,7 +26,6 @@ SECONDS = 1.0
 
 
 @pytest.mark.mocap
-@pytest.mark.slow
 @pytest.mark.parametrize("source", sorted(CLIPS))
 def test_controllerpose_runs_on_a_real_clip(source, mocap_dir, cp_run, monkeypatch):
     motion = read_bvh(mocap_dir / CLIPS[source])

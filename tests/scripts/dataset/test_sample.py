@@ -6,10 +6,14 @@ import numpy as np
 import pytest
 
 from avatar_models.body17 import INDEX
+from avatar_models.generator import Subject, generate
+from avatar_models.rigs import body17_positions
+from scripts.dataset.channels import kinect_channel, physics_channel
 from scripts.dataset.config import config_hash, from_dict
 from scripts.dataset.plan import plan_samples
 from scripts.dataset.sample import make_sample
 from scripts.dataset.shards import read_samples, shard_bytes
+from sim.humanoid import humanoid_for
 from tests.scripts.dataset.builders import TINY
 
 
@@ -54,6 +58,44 @@ def test_ground_truth_and_devices_agree(first_sample):
     assert arrays["contact"].any(axis=1).mean() > 0.9
     assert arrays["penetration_m"].shape == (t,) and arrays["skate_m_s"].shape == (t, 2)
     assert sorted(arrays) == meta["arrays"]
+
+
+@pytest.fixture(scope="module")
+def wave():
+    """1 s of a standing wave at the datasets' 30 Hz: both feet on the floor throughout."""
+    return generate("wave", Subject(height_m=1.75), 1.0, 30.0, seed=4)
+
+
+def _moved(motion, shift):
+    return humanoid_for(motion.replace(root_pos=motion.root_pos + np.asarray(shift)))
+
+
+def test_penetration_label_is_metres_of_depth_below_the_floor(wave):
+    """Sinking the same pose 4 cm deeper deepens MuJoCo's deepest floor contact by 4 cm:
+    the label's difference is 0.04 (metres), whatever the depth it starts from."""
+    shallow, _ = physics_channel(_moved(wave, [0.0, 0.0, -0.03]))
+    deep, meta = physics_channel(_moved(wave, [0.0, 0.0, -0.07]))
+    assert shallow["penetration_m"].min() > 0.0  # in contact at every frame
+    np.testing.assert_allclose(deep["penetration_m"] - shallow["penetration_m"], 0.04, atol=1e-4)
+    assert meta["units"].startswith("m,")
+
+
+def test_kinect_positions_follow_the_body_along_the_world_axes(wave):
+    """The same body moved 0.8 m along +X and 0.3 m along -Y in the world (the sensor set up
+    again in front of it, the same seed): its tracked joints move by exactly that, axis by
+    axis, and sit on the ground truth's joints."""
+    here, _ = kinect_channel(_moved(wave, [0.0, 0.0, 0.0]), "kinect-v2", seed=5)
+    moved_humanoid = _moved(wave, [0.8, -0.3, 0.0])
+    there, _ = kinect_channel(moved_humanoid, "kinect-v2", seed=5)
+    tracked = (here["kinect_state"] == 2) & (there["kinect_state"] == 2)
+    assert tracked.mean() > 0.5
+    shift = (there["kinect_pos"] - here["kinect_pos"])[tracked]  # (n, 3)
+    np.testing.assert_allclose(np.median(shift, axis=0), [0.8, -0.3, 0.0], atol=0.01)
+    # The Kinect's head (joint 3 of the Kinect V2's 25) over the moved body's head: within
+    # 5 cm along X and Y (the two joints are different points of the head, ~10 cm apart in Z).
+    head = body17_positions(moved_humanoid.motion)[:, INDEX["head"], :2]
+    gap = np.abs(there["kinect_pos"][:, 3, :2] - head)[there["kinect_state"][:, 3] == 2]
+    assert np.all(np.median(gap, axis=0) < 0.05), np.median(gap, axis=0)
 
 
 def test_provenance(first_sample):
