@@ -1,7 +1,8 @@
 """``FisheyeRig``: the fisheye cameras on the VR controllers (ControllerPose §4) as one ``Device``.
 
 ``FisheyeRig(...).sample(motion, seed, body) -> FisheyeRecording`` renders every controller
-camera over ``motion`` at the sensor's 30 Hz (ControllerPose §4.1), in memory: colour frames
+camera over ``motion`` at 30 Hz (our choice, an analog camera's video rate; the paper gives no
+camera rate, its pipeline runs at 7.2 FPS, §4.4), in memory: colour frames
 with bad frames injected (§4.2, about 1 in 50) when ``bad_frame_rate > 0``, the range along
 each pixel's ray, and one self-describing record per camera frame
 (:mod:`render_cams.fisheye.records`), incl. the bad-frame ground truth and the occlusion flags
