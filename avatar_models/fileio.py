@@ -10,6 +10,7 @@ that file with mode 0600; :func:`atomic_file` gives it the mode a plain ``open()
 from __future__ import annotations
 
 import csv
+import hashlib
 import json
 import math
 import os
@@ -60,6 +61,15 @@ def write_atomic(path: str | Path, data: bytes | str) -> Path:
     with atomic_file(path) as fh:
         fh.write(data.encode("utf-8") if isinstance(data, str) else data)
     return Path(path)
+
+
+def sha256_file(path: str | Path) -> str:
+    """Hex SHA-256 of the file at ``path``, read in 1 MiB blocks."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
 
 
 def json_safe(value: Any) -> Any:

@@ -13,22 +13,13 @@ file, or anyone else's, is refused before any work starts (:func:`check_replacea
 
 from __future__ import annotations
 
-import hashlib
 import json
 from pathlib import Path
 
 from avatar_models.errors import AvatarsimError
-from avatar_models.fileio import write_atomic, write_json
+from avatar_models.fileio import sha256_file, write_atomic, write_json
 
 REGISTRY = ".avatarsim-files.json"
-
-
-def _sha256(path: Path) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
 
 
 def _registry(folder: Path) -> dict[str, str]:
@@ -47,7 +38,7 @@ def written_by_us(path: Path) -> bool:
     """``path`` is a file avatarsim wrote and nobody changed since."""
     path = Path(path)
     recorded = _registry(path.parent).get(path.name)
-    return recorded is not None and path.is_file() and _sha256(path) == recorded
+    return recorded is not None and path.is_file() and sha256_file(path) == recorded
 
 
 def check_replaceable(path: Path | None, option: str) -> None:
@@ -69,7 +60,7 @@ def record_output(path: Path) -> Path:
     """Record the file ``path`` (just written by avatarsim) as ours; returns ``path``."""
     path = Path(path)
     files = _registry(path.parent)
-    files[path.name] = _sha256(path)
+    files[path.name] = sha256_file(path)
     write_json(path.parent / REGISTRY, {"files": dict(sorted(files.items()))})
     return path
 

@@ -15,7 +15,6 @@ JSON is written with sorted keys, so the same samples always give the same bytes
 
 from __future__ import annotations
 
-import hashlib
 import io
 import json
 import tarfile
@@ -95,14 +94,6 @@ def decode_entry(name: str, data: bytes) -> np.ndarray | dict[str, Any] | None:
     if name.endswith(".npy"):
         return np.load(io.BytesIO(data), allow_pickle=False)
     return None
-
-
-def sha256_file(path: Path) -> str:
-    digest = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            digest.update(block)
-    return digest.hexdigest()
 
 
 def read_samples(path: Path) -> Iterator[tuple[str, dict[str, Any]]]:

@@ -5,8 +5,9 @@ import shutil
 
 import pytest
 
+from avatar_models.fileio import sha256_file
 from scripts.dataset.manifest import DatasetError
-from scripts.dataset.shards import read_samples, sha256_file, shard_bytes
+from scripts.dataset.shards import read_samples, shard_bytes
 from scripts.dataset.verify import verify_dataset
 
 
