@@ -46,8 +46,13 @@ def _private(name: str) -> bool:
     return name.startswith("_") and not name.startswith("__")
 
 
+def _ours(module: str, packages: tuple[str, ...]) -> bool:
+    """Whether dotted ``module`` is one of ``packages`` (dotted names) or inside one."""
+    return any(module == p or module.startswith(p + ".") for p in packages)
+
+
 def private_uses_in(path: Path, packages: Iterable[str], root: Path = ROOT) -> Iterator[PrivateUse]:
-    """The private names of our ``packages`` that the file at ``path`` uses."""
+    """The private names of our ``packages`` (dotted names) that the file at ``path`` uses."""
     packages = tuple(packages)
     rel = str(path.relative_to(root))
     tree = ast.parse(path.read_text(), filename=rel)
@@ -56,14 +61,14 @@ def private_uses_in(path: Path, packages: Iterable[str], root: Path = ROOT) -> I
         if isinstance(node, ast.Import):
             for alias in node.names:
                 parts = alias.name.split(".")
-                if parts[0] not in packages:
+                if not _ours(alias.name, packages):
                     continue
                 if any(map(_private, parts)):
                     yield PrivateUse(rel, node.lineno, f"import {alias.name}")
                 ours.add(alias.asname or parts[0])
         elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
             parts = node.module.split(".")
-            if parts[0] not in packages:
+            if not _ours(node.module, packages):
                 continue
             if any(map(_private, parts)):
                 yield PrivateUse(rel, node.lineno, f"from {node.module} import ...")

@@ -5,7 +5,9 @@ from pathlib import Path
 
 from tests.private_names import PrivateUse, private_uses, private_uses_in
 
-PACKAGES = ("avatar_models", "render_cams", "synthesis", "sim", "scripts")
+PACKAGES = tuple(
+    f"avatarsim.{p}" for p in ("avatar_models", "render_cams", "synthesis", "sim", "scripts")
+)
 
 
 def test_no_module_or_test_uses_another_modules_private_name():
@@ -16,9 +18,9 @@ def test_no_module_or_test_uses_another_modules_private_name():
 def test_the_check_finds_each_kind_of_private_use(tmp_path):
     source = tmp_path / "user.py"
     source.write_text(
-        "import sim._hidden\n"
-        "from sim.tracking import _up, Tracker\n"
-        "from avatar_models import quat as q\n"
+        "import avatarsim.sim._hidden\n"
+        "from avatarsim.sim.tracking import _up, Tracker\n"
+        "from avatarsim.avatar_models import quat as q\n"
         "import numpy as np\n"
         "q._normalise(np._private)\n"
         "Tracker._com_jacobian\n"
@@ -27,10 +29,10 @@ def test_the_check_finds_each_kind_of_private_use(tmp_path):
     )
     uses = sorted(private_uses_in(source, PACKAGES, root=tmp_path), key=lambda u: u.line)
     assert [(u.line, u.what) for u in uses] == [
-        (1, "import sim._hidden"),
-        (2, "from sim.tracking import _up"),
+        (1, "import avatarsim.sim._hidden"),
+        (2, "from avatarsim.sim.tracking import _up"),
         (5, "q._normalise"),
         (6, "Tracker._com_jacobian"),
     ]
-    assert uses[0] == PrivateUse("user.py", 1, "import sim._hidden")
+    assert uses[0] == PrivateUse("user.py", 1, "import avatarsim.sim._hidden")
     assert not list(private_uses_in(Path(__file__), PACKAGES))  # this file is clean

@@ -1,6 +1,7 @@
-"""The built wheel ships what the checkout holds: every data file of the five packages (rigs,
-shaders, scenarios in their sub-folders, dataset configs, models), read back from the wheel
-with :mod:`zipfile`, and dependencies as ranges."""
+"""The built wheel ships what the checkout holds, under one import namespace: every data file
+of the five folders (rigs, shaders, scenarios in their sub-folders, dataset configs, models)
+as ``avatarsim/<folder>/...``, read back from the wheel with :mod:`zipfile`, nothing else at
+the top of site-packages, and dependencies as ranges."""
 
 from __future__ import annotations
 
@@ -49,8 +50,14 @@ def tracked_data_files() -> set[str]:
 def test_every_data_file_is_in_the_wheel(wheel):
     data = tracked_data_files()
     assert any(f.startswith("scripts/scenarios/smoke/") for f in data)  # the suites are there
-    missing = data - set(wheel.namelist())
+    missing = {f"avatarsim/{f}" for f in data} - set(wheel.namelist())
     assert not missing, f"not in the wheel: {sorted(missing)}"
+
+
+def test_everything_installs_under_the_avatarsim_namespace(wheel):
+    """Nothing called ``sim`` or ``scripts`` at the top of site-packages."""
+    tops = {name.split("/", 1)[0] for name in wheel.namelist()}
+    assert {t for t in tops if not t.endswith(".dist-info")} == {"avatarsim"}
 
 
 def test_runtime_dependencies_are_ranges(wheel):
