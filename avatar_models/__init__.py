@@ -11,7 +11,7 @@ if "MUJOCO_GL" not in os.environ:
     os.environ["MUJOCO_GL"] = "osmesa" if no_egl and ctypes.util.find_library("OSMesa") else "egl"
 os.environ.setdefault("PYOPENGL_PLATFORM", os.environ["MUJOCO_GL"])
 
-from avatar_models.errors import (
+from avatarsim.avatar_models.errors import (
     AvatarsimError,
     CalibrationError,
     MotionFormatError,
@@ -19,8 +19,8 @@ from avatar_models.errors import (
     RigError,
     UnknownJointError,
 )
-from avatar_models.motion import Motion
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.skeleton import Skeleton
 
 __all__ = [
     "AvatarsimError",

@@ -38,8 +38,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import quat
-from avatar_models.body17 import BODY17, INDEX
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body17 import BODY17, INDEX
 
 PARENT_NAMES: dict[str, str] = {
     "neck": "pelvis",

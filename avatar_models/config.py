@@ -29,7 +29,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Literal, TypeVar
 
-from avatar_models.errors import AvatarsimError
+from avatarsim.avatar_models.errors import AvatarsimError
 
 T = TypeVar("T")
 BOUNDS = {"ge": ">=", "gt": ">", "le": "<=", "lt": "<"}

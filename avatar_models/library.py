@@ -30,9 +30,9 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from avatar_models.errors import AvatarsimError, MotionValueError
-from avatar_models.formats import load_motion
-from avatar_models.motion import Motion
+from avatarsim.avatar_models.errors import AvatarsimError, MotionValueError
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.motion import Motion
 
 MOTION_SUFFIXES = (".bvh", ".amc", ".npz")
 LABEL_KEYS = ("activity", "subject", "style", "take")

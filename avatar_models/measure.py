@@ -25,10 +25,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.errors import MotionFormatError, MotionValueError, RigError
-from avatar_models.motion import Motion
-from avatar_models.rigs import identify_rig
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models.errors import MotionFormatError, MotionValueError, RigError
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.rigs import identify_rig
+from avatarsim.avatar_models.skeleton import Skeleton
 
 ANKLE_FRAC = 0.039  # ankle joint height / standing height (Drillis & Contini 1966)
 HEAD_TOP_FRAC = 0.10  # skull-base head joint to the top of the head / standing height
@@ -100,7 +100,7 @@ PLAUSIBLE_HEIGHT_M = (0.5, 2.5)
 def check_plausible_height(motion: Motion) -> float:
     """The motion's standing height (m); a :class:`MotionValueError` when it is no person's,
     which after a unit conversion means the wrong unit (the message names the one that fits)."""
-    from avatar_models.formats.units import detect_unit
+    from avatarsim.avatar_models.formats.units import detect_unit
 
     height = standing_height(motion)
     lo, hi = PLAUSIBLE_HEIGHT_M

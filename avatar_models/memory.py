@@ -14,7 +14,7 @@ import os
 import re
 from pathlib import Path
 
-from avatar_models.config import ConfigError
+from avatarsim.avatar_models.config import ConfigError
 
 MEMORY_LIMIT_ENV = "AVATARSIM_MEMORY_LIMIT"
 UNITS = {"": 1, "K": 2**10, "M": 2**20, "G": 2**30, "T": 2**40}

@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-from avatar_models.errors import AvatarsimError
+from avatarsim.avatar_models.errors import AvatarsimError
 
 MOCAP_ENV = "AVATARSIM_MOCAP"
 

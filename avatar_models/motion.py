@@ -15,9 +15,9 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
-from avatar_models.errors import MotionValueError
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.skeleton import Skeleton
 
 # Frame rates a motion may have (frames per second): mocap runs at 30-480 Hz, a 1 kHz system
 # is the fastest one records BVH from; anything outside is a wrong Frame Time or --fps.

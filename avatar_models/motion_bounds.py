@@ -30,8 +30,8 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.errors import MotionValueError
-from avatar_models.motion import Motion
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.motion import Motion
 
 MAX_DISTANCE_M = 1000.0
 MAX_SPEED_M_S = 100.0
@@ -55,7 +55,7 @@ def _first(bad: np.ndarray) -> tuple[int, ...] | None:
 def _unit_first(motion: Motion, source: str | Path, error: MotionValueError) -> None:
     """Raise the height check's error (it names the unit that fits) when the body is no
     person's height: a wrong unit explains a bound passed; else ``error``."""
-    from avatar_models.measure import check_plausible_height
+    from avatarsim.avatar_models.measure import check_plausible_height
 
     try:
         check_plausible_height(motion)

@@ -27,10 +27,10 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.body17 import BODY17
-from avatar_models.errors import RigError
-from avatar_models.motion import Motion
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.avatar_models.errors import RigError
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.skeleton import Skeleton
 
 RIG_DIR = Path(__file__).parent / "rigs"
 

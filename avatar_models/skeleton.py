@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from avatar_models.errors import MotionValueError, UnknownJointError
+from avatarsim.avatar_models.errors import MotionValueError, UnknownJointError
 
 # Left/right name patterns tried in order when mirroring or pairing joints.
 _SIDE_PATTERNS: tuple[tuple[str, str], ...] = (

@@ -4,14 +4,14 @@ Every device follows the small :class:`~render_cams.device.Device` protocol:
 ``device.sample(motion, seed) -> stream``.
 """
 
-from render_cams.device import Device, DeviceError
-from render_cams.tracking import (
+from avatarsim.render_cams.device import Device, DeviceError
+from avatarsim.render_cams.tracking import (
     StreamError,
     StreamFormatError,
     TrackingStream,
     UnknownDeviceError,
 )
-from render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
+from avatarsim.render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
 
 __all__ = [
     "FULL_BODY",

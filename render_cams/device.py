@@ -26,7 +26,7 @@ from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 
-from avatar_models import AvatarsimError, Motion
+from avatarsim.avatar_models import AvatarsimError, Motion
 
 
 class DeviceError(AvatarsimError, ValueError):

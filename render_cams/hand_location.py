@@ -18,9 +18,9 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from avatar_models import Motion
-from avatar_models.body17 import INDEX
-from avatar_models.rigs import body17_positions
+from avatarsim.avatar_models import Motion
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.avatar_models.rigs import body17_positions
 
 PAPER_IN_FRONT_SHARE = 0.683  # ControllerPose §3
 PAPER_CAMERA_TO_BODY_M = 0.430  # ControllerPose §3

@@ -35,8 +35,8 @@ import pyrender
 from OpenGL import GL
 from pyrender.shader_program import ShaderProgramCache
 
-import avatar_models  # noqa: F401  (picks the OpenGL backend before pyrender loads)
-from avatar_models import AvatarsimError
+import avatarsim.avatar_models  # noqa: F401  (picks the OpenGL backend before pyrender loads)
+from avatarsim.avatar_models import AvatarsimError
 
 # Private names this module relies on, per pyrender class: methods it overrides (with their
 # parameters) and attributes it reads or replaces.

@@ -39,12 +39,12 @@ import numpy as np
 import pyrender
 import trimesh
 
-import avatar_models  # noqa: F401  (picks the OpenGL backend before pyrender loads)
-from avatar_models import AvatarsimError, Motion, quat
-from avatar_models.body import BodyDescription, build_body
-from avatar_models.body.mesh import mesh_template
-from avatar_models.skeleton import Skeleton
-from render_cams.pyrender_patch import close_renderer, open_renderer
+import avatarsim.avatar_models  # noqa: F401  (picks the OpenGL backend before pyrender loads)
+from avatarsim.avatar_models import AvatarsimError, Motion, quat
+from avatarsim.avatar_models.body import BodyDescription, build_body
+from avatarsim.avatar_models.body.mesh import mesh_template
+from avatarsim.avatar_models.skeleton import Skeleton
+from avatarsim.render_cams.pyrender_patch import close_renderer, open_renderer
 
 # OpenCV camera axes (x right, y down, z forward) -> pyrender/OpenGL (x right, y up, z back).
 CV_TO_GL = np.diag([1.0, -1.0, -1.0, 1.0])

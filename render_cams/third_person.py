@@ -12,11 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.body17 import INDEX
-from render_cams.fisheye.pose2d import inside
-from render_cams.fisheye.pose_detector import ViewTruth
-from render_cams.kinect.placement import look_at
-from render_cams.scene import BodyScene, pinhole_K
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.render_cams.fisheye.pose2d import inside
+from avatarsim.render_cams.fisheye.pose_detector import ViewTruth
+from avatarsim.render_cams.kinect.placement import look_at
+from avatarsim.render_cams.scene import BodyScene, pinhole_K
 
 DISTANCE_M = 3.0
 EYE_HEIGHT_M = 1.0

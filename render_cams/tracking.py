@@ -22,8 +22,8 @@ from typing import Any
 
 import numpy as np
 
-from avatar_models import AvatarsimError
-from avatar_models.fileio import atomic_file
+from avatarsim.avatar_models import AvatarsimError
+from avatarsim.avatar_models.fileio import atomic_file
 
 # Fixed zip entry time so that the same stream always gives the same file bytes.
 _ZIP_EPOCH = (1980, 1, 1, 0, 0, 0)

@@ -23,11 +23,11 @@ from pathlib import Path
 
 import numpy as np
 
-from scripts.stages.devices import REALISTIC_NOISE
-from sim.humanoid import humanoid_for
-from sim.plausibility import CONTRACT_KEYS, check_humanoid
-from sim.thresholds import CheckConfig
-from synthesis.avatargo.study import (
+from avatarsim.scripts.stages.devices import REALISTIC_NOISE
+from avatarsim.sim.humanoid import humanoid_for
+from avatarsim.sim.plausibility import CONTRACT_KEYS, check_humanoid
+from avatarsim.sim.thresholds import CheckConfig
+from avatarsim.synthesis.avatargo.study import (
     EFFECTORS,
     LIMB_SPREAD,
     PROXY,
@@ -37,8 +37,8 @@ from synthesis.avatargo.study import (
     sample_user,
     study_run,
 )
-from synthesis.avatargo.synthesizer import ANALYTIC, SOLVER_LABELS
-from synthesis.evaluate import Trial
+from avatarsim.synthesis.avatargo.synthesizer import ANALYTIC, SOLVER_LABELS
+from avatarsim.synthesis.evaluate import Trial
 
 TASKS = {"arms": "T1 arms", "squat": "T2 squats", "walk": "T3 free", "box": "T3 free",
          "kick": "T3 free"}  # fmt: skip

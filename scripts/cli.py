@@ -17,10 +17,10 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-import scripts.commands
-from avatar_models.errors import AvatarsimError
-from avatar_models.mocap_dir import MOCAP_ENV, mocap_dir
-from scripts.cli_common import (
+from avatarsim.avatar_models.errors import AvatarsimError
+from avatarsim.avatar_models.mocap_dir import MOCAP_ENV, mocap_dir
+from avatarsim.scripts import commands
+from avatarsim.scripts.cli_common import (
     JsonOpt,
     SeedOpt,
     check_outputs,
@@ -48,8 +48,8 @@ def info(
     json_out: JsonOpt = None,
 ) -> None:
     """Skeleton, fps, frames and size of a motion file."""
-    from avatar_models.errors import MotionValueError
-    from avatar_models.measure import check_plausible_height, standing_height
+    from avatarsim.avatar_models.errors import MotionValueError
+    from avatarsim.avatar_models.measure import check_plausible_height, standing_height
 
     check_outputs(json_out=json_out)
     m = load_motion_arg(motion, unit, seed, check_height=False)
@@ -92,9 +92,9 @@ def convert(
     json_out: JsonOpt = None,
 ) -> None:
     """Convert BVH / ASF+AMC / NPZ to BVH or NPZ, optionally resampled."""
-    from avatar_models.formats import WRITABLE, save_motion
-    from avatar_models.motion import check_fps
-    from scripts.output_file import record_output
+    from avatarsim.avatar_models.formats import WRITABLE, save_motion
+    from avatarsim.avatar_models.motion import check_fps
+    from avatarsim.scripts.output_file import record_output
 
     if fps is not None:
         check_fps(fps, "--fps")
@@ -113,7 +113,7 @@ def convert(
 
 
 def _run(scenario_obj: Any, out: Path, json_out: Path | None) -> None:
-    from scripts.pipeline import run_scenario
+    from avatarsim.scripts.pipeline import run_scenario
 
     results = run_scenario(scenario_obj, out, err_console)
     table = Table(title=f"scenario {escape(results['scenario'])}")
@@ -162,15 +162,20 @@ def run(
     One scenario file writes its outputs into --out. Several, a folder, -k or a baseline make
     a suite: a folder per scenario plus junit.xml, results.json and index.html for them all.
     """
-    from scripts.suite.command import SuiteOptions, check_options, print_summary, run_paths
-    from scripts.suite.regression import baseline_file
+    from avatarsim.scripts.suite.command import (
+        SuiteOptions,
+        check_options,
+        print_summary,
+        run_paths,
+    )
+    from avatarsim.scripts.suite.regression import baseline_file
 
     options = SuiteOptions(workers, fail_fast, select, baseline, update_baseline, seed)
     check_options(options)
     replaced = {"--baseline": baseline_file(baseline) if update_baseline else None}
     check_outputs(json_out=json_out, out=out, out_owner="run", replaced=replaced)
     if len(scenarios) == 1 and scenarios[0].is_file() and not (select or baseline):
-        from scripts.scenario import load_scenario
+        from avatarsim.scripts.scenario import load_scenario
 
         sc = load_scenario(scenarios[0])
         if seed is not None:
@@ -192,7 +197,7 @@ def demo(
     json_out: JsonOpt = None,
 ) -> None:
     """The default scenario on built-in motion, end to end (results, pictures)."""
-    from scripts.scenario import DEFAULT_SCENARIO, load_scenario
+    from avatarsim.scripts.scenario import DEFAULT_SCENARIO, load_scenario
 
     check_outputs(json_out=json_out, out=out, out_owner="run")
     sc = dataclasses.replace(load_scenario(DEFAULT_SCENARIO), seed=seed)
@@ -215,7 +220,7 @@ def bench(
     ] = None,
 ) -> None:
     """Benchmarks: prints a table, writes JSON (name, unit, value, baseline, ratio)."""
-    from scripts.benchmarks import BENCHMARKS, run_benchmark
+    from avatarsim.scripts.benchmarks import BENCHMARKS, run_benchmark
 
     json_out = json_out or Path("out/bench/bench.json")
     check_outputs(json_out=json_out)
@@ -244,8 +249,8 @@ def bench(
     emit_json(json_out, payload)
 
 
-for _module in pkgutil.iter_modules(scripts.commands.__path__):
-    importlib.import_module(f"scripts.commands.{_module.name}").register(app)
+for _module in pkgutil.iter_modules(commands.__path__):
+    importlib.import_module(f"avatarsim.scripts.commands.{_module.name}").register(app)
 
 
 def main() -> None:  # pragma: no cover - console entry point

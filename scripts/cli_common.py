@@ -20,13 +20,13 @@ import typer
 from rich.console import Console
 from rich.markup import escape
 
-from avatar_models.errors import AvatarsimError, MotionValueError
-from scripts.scenario import MIN_FRAMES  # noqa: F401  (re-exported for the commands)
+from avatarsim.avatar_models.errors import AvatarsimError, MotionValueError
+from avatarsim.scripts.scenario import MIN_FRAMES  # noqa: F401  (re-exported for the commands)
 
 if TYPE_CHECKING:  # imported by the commands that use them (keeps `--help` fast)
     import numpy as np
 
-    from sim.humanoid import Humanoid
+    from avatarsim.sim.humanoid import Humanoid
 
 INTERNAL_ERROR = 3  # exit code of a bug (0 ok, 1 a check failed, 2 bad input)
 
@@ -155,7 +155,7 @@ def check_outputs(
     ``files`` by option name (none of them an existing file avatarsim did not write) and
     files the command ``replaced`` on purpose (checked by the command: ``--update-baseline``).
     Bad paths raise :class:`AvatarsimError` (exit 2)."""
-    from scripts.results import check_output_dir, check_output_file
+    from avatarsim.scripts.results import check_output_dir, check_output_file
 
     check_output_file(json_out, "--json")
     for option, path in (files or {}).items():
@@ -192,8 +192,8 @@ def emit_json(path: Path | None, payload: dict[str, Any], option: str = "--json"
     """Write ``payload`` to the user's JSON file ``path`` (none when None), never over a file
     avatarsim did not write (:mod:`scripts.output_file`)."""
     if path is not None:
-        from avatar_models.fileio import json_text
-        from scripts.output_file import write_output
+        from avatarsim.avatar_models.fileio import json_text
+        from avatarsim.scripts.output_file import write_output
 
         write_output(path, json_text(payload), option)
 
@@ -201,7 +201,7 @@ def emit_json(path: Path | None, payload: dict[str, Any], option: str = "--json"
 def export_viewer(humanoid: Humanoid, qpos: np.ndarray, fps: float, export: Path) -> None:
     """Write ``qpos (T, nq)`` of ``humanoid`` at ``fps`` into ``export`` for MuJoCo's viewer
     (:func:`sim.export.export_replay`) and say how to open it."""
-    from sim.export import export_replay
+    from avatarsim.sim.export import export_replay
 
     export_replay(humanoid, qpos, fps, export)
     console.print(
@@ -236,7 +236,7 @@ def load_motion_arg(
     that takes a MOTION accepts both). A clip shorter than ``min_frames`` frames or (with
     ``check_height``) a body of no person's height is bad input."""
     if arg.startswith(BUILTIN_PREFIX):
-        from avatar_models.generator import ACTIVITIES, generate
+        from avatarsim.avatar_models.generator import ACTIVITIES, generate
 
         activity = arg[len(BUILTIN_PREFIX) :]
         if activity not in ACTIVITIES:
@@ -246,8 +246,8 @@ def load_motion_arg(
         if unit is not None:
             raise AvatarsimError(f"--unit applies to motion files; {arg} is in metres already")
         return generate(activity, duration_s=duration_s, seed=seed)
-    from avatar_models.formats import load_motion
-    from avatar_models.measure import check_plausible_height
+    from avatarsim.avatar_models.formats import load_motion
+    from avatarsim.avatar_models.measure import check_plausible_height
 
     m = load_motion(Path(arg), **unit_option(unit))
     if m.n_frames < min_frames:

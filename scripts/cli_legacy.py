@@ -14,7 +14,7 @@ import click
 from rich.markup import escape
 from typer.core import TyperGroup
 
-from scripts.cli_common import err_console
+from avatarsim.scripts.cli_common import err_console
 
 Rewrite = Callable[[list[str], Collection[str]], "tuple[list[str], str] | None"]
 

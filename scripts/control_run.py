@@ -9,9 +9,9 @@ import time
 import mujoco
 import numpy as np
 
-from sim.control import search as control_search
-from sim.control.controller import ControlResult, control
-from sim.control.search import SearchSettings
+from avatarsim.sim.control import search as control_search
+from avatarsim.sim.control.controller import ControlResult, control
+from avatarsim.sim.control.search import SearchSettings
 
 
 def timed_control(

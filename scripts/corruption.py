@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.body import build_body
-from avatar_models.motion import Motion
-from scripts.scenario import CORRUPTIONS
-from sim import corrupt
-from sim.plausibility import check_motion
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.scripts.scenario import CORRUPTIONS
+from avatarsim.sim import corrupt
+from avatarsim.sim.plausibility import check_motion
 
 
 def corrupted(motion: Motion, defect: str, seed: int) -> Motion:

@@ -28,28 +28,28 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models import Motion
-from avatar_models.fileio import write_json
-from avatar_models.measure import standing_height
-from render_cams import VRSetup
-from render_cams.vr import FULL_BODY
-from scripts.dataset import executors
-from scripts.method_score import score_method
-from scripts.movebox_eval import body17_tracked, filmed
-from scripts.report_html import image_html, page, table_html
-from sim.thresholds import CheckConfig
-from synthesis.avatargo.walk_in import walk_in
-from synthesis.base import SynthesisError
-from synthesis.controllerpose.synthesizer import KeypointRecording
-from synthesis.evaluate import (
+from avatarsim.avatar_models import Motion
+from avatarsim.avatar_models.fileio import write_json
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.render_cams import VRSetup
+from avatarsim.render_cams.vr import FULL_BODY
+from avatarsim.scripts.dataset import executors
+from avatarsim.scripts.method_score import score_method
+from avatarsim.scripts.movebox_eval import body17_tracked, filmed
+from avatarsim.scripts.report_html import image_html, page, table_html
+from avatarsim.sim.thresholds import CheckConfig
+from avatarsim.synthesis.avatargo.walk_in import walk_in
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.controllerpose.synthesizer import KeypointRecording
+from avatarsim.synthesis.evaluate import (
     EvaluationError,
     Trial,
     database_for,
     folds,
     ik_rig_for,
 )
-from synthesis.evaluate.validation import choose_max_distance
-from synthesis.methods import METHODS, MethodInputs, build, ready_methods
+from avatarsim.synthesis.evaluate.validation import choose_max_distance
+from avatarsim.synthesis.methods import METHODS, MethodInputs, build, ready_methods
 
 COLUMNS = {
     "hands_cm": "hands",
@@ -77,8 +77,8 @@ PHYSICS = (
 def fisheye_keypoints(motion: Motion, seed: int) -> KeypointRecording:
     """The controller cameras' keypoints of a test motion (ControllerPose's input), the
     detector's errors seeded like the trial's VR stream."""
-    from scripts.controllerpose.recording import keypoint_recording
-    from sim.humanoid import humanoid_for
+    from avatarsim.scripts.controllerpose.recording import keypoint_recording
+    from avatarsim.sim.humanoid import humanoid_for
 
     return keypoint_recording(humanoid_for(motion), seed)
 
@@ -113,7 +113,8 @@ def sensors_of(methods: Sequence[str]) -> list[str]:
     missing = [s for s in needed if s not in RECORDERS]
     if missing:
         raise EvaluationError(
-            f"no recorder for sensor(s) {', '.join(missing)} (scripts.leaderboard.RECORDERS); "
+            f"no recorder for sensor(s) {', '.join(missing)} "
+            "(avatarsim.scripts.leaderboard.RECORDERS); "
             "leave out the methods that read them"
         )
     return needed

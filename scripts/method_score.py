@@ -10,13 +10,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from avatar_models import Motion
-from render_cams import TrackingStream
-from sim.humanoid import Humanoid, humanoid_for
-from sim.plausibility import check_humanoid
-from sim.thresholds import CheckConfig
-from synthesis.base import Synthesizer
-from synthesis.scoring import MethodScore, score_run
+from avatarsim.avatar_models import Motion
+from avatarsim.render_cams import TrackingStream
+from avatarsim.sim.humanoid import Humanoid, humanoid_for
+from avatarsim.sim.plausibility import check_humanoid
+from avatarsim.sim.thresholds import CheckConfig
+from avatarsim.synthesis.base import Synthesizer
+from avatarsim.synthesis.scoring import MethodScore, score_run
 
 
 @dataclass(frozen=True, eq=False)

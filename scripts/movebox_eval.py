@@ -40,32 +40,32 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models import Motion, quat
-from avatar_models.body.errors import RestPoseNotUprightError
-from avatar_models.formats import load_motion
-from avatar_models.generator import generate
-from avatar_models.measure import standing_height
-from avatar_models.rigs import body17_positions, load_rig
-from render_cams.device import motion_at_rate
-from render_cams.kinect import (
+from avatarsim.avatar_models import Motion, quat
+from avatarsim.avatar_models.body.errors import RestPoseNotUprightError
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.rigs import body17_positions, load_rig
+from avatarsim.render_cams.device import motion_at_rate
+from avatarsim.render_cams.kinect import (
     KinectSkeletonStream,
     TrackingState,
     kinect_skeleton,
     read_kinect_skeleton,
 )
-from render_cams.kinect.sensors import KINECT_RATE_HZ
-from render_cams.vr import VRSetup
-from scripts.method_score import score_method
-from sim.humanoid import Humanoid, humanoid_for
-from sim.thresholds import CheckConfig
-from synthesis.base import SynthesisError, on_clock
-from synthesis.movebox import MoveBox, check_stream
-from synthesis.movebox.face import AudioFormatError, lip_sync, read_wav
-from synthesis.movebox.mapping import mapping_for
-from synthesis.movebox.resize import avatar_for, resized, user_height_m
-from synthesis.movebox.retarget import ROLLS, Retargeting, twist_angle
-from synthesis.movebox.similarity import loop_points, seam_index
-from synthesis.scoring import body17_errors_cm
+from avatarsim.render_cams.kinect.sensors import KINECT_RATE_HZ
+from avatarsim.render_cams.vr import VRSetup
+from avatarsim.scripts.method_score import score_method
+from avatarsim.sim.humanoid import Humanoid, humanoid_for
+from avatarsim.sim.thresholds import CheckConfig
+from avatarsim.synthesis.base import SynthesisError, on_clock
+from avatarsim.synthesis.movebox import MoveBox, check_stream
+from avatarsim.synthesis.movebox.face import AudioFormatError, lip_sync, read_wav
+from avatarsim.synthesis.movebox.mapping import mapping_for
+from avatarsim.synthesis.movebox.resize import avatar_for, resized, user_height_m
+from avatarsim.synthesis.movebox.retarget import ROLLS, Retargeting, twist_angle
+from avatarsim.synthesis.movebox.similarity import loop_points, seam_index
+from avatarsim.synthesis.scoring import body17_errors_cm
 
 SENSORS = ("kinect-v2", "azure-kinect")
 ACTIVITIES = ("walk", "box", "wave", "squat")

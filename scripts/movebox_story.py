@@ -13,16 +13,22 @@ import cv2
 import imageio.v2 as imageio
 import numpy as np
 
-from avatar_models import Motion
-from avatar_models.fileio import write_atomic
-from avatar_models.generator import Subject, generate
-from avatar_models.rigs import load_rig
-from render_cams.kinect import kinect_skeleton
-from synthesis.movebox import MoveBox
-from synthesis.movebox.face import lip_sync, read_wav
-from synthesis.movebox.recording import playback
-from synthesis.movebox.resize import resized
-from synthesis.movebox.storytelling import ACTOR_RGBA, Actor, drawn_bones, scene_spec, stage
+from avatarsim.avatar_models import Motion
+from avatarsim.avatar_models.fileio import write_atomic
+from avatarsim.avatar_models.generator import Subject, generate
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.render_cams.kinect import kinect_skeleton
+from avatarsim.synthesis.movebox import MoveBox
+from avatarsim.synthesis.movebox.face import lip_sync, read_wav
+from avatarsim.synthesis.movebox.recording import playback
+from avatarsim.synthesis.movebox.resize import resized
+from avatarsim.synthesis.movebox.storytelling import (
+    ACTOR_RGBA,
+    Actor,
+    drawn_bones,
+    scene_spec,
+    stage,
+)
 
 CAST = (
     # activity, performer height, avatar height, mark (x, y), facing (rad)

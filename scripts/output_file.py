@@ -16,8 +16,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from avatar_models.errors import AvatarsimError
-from avatar_models.fileio import sha256_file, write_atomic, write_json
+from avatarsim.avatar_models.errors import AvatarsimError
+from avatarsim.avatar_models.fileio import sha256_file, write_atomic, write_json
 
 REGISTRY = ".avatarsim-files.json"
 

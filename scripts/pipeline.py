@@ -15,15 +15,15 @@ from typing import Any
 from rich.console import Console
 from rich.markup import escape
 
-from avatar_models.fileio import write_atomic, write_json
-from scripts.report_html import render_report
-from scripts.results import ThresholdResult, atomic_dir, junit_xml, versions
-from scripts.run_context import RunContext
-from scripts.scenario import Scenario, ScenarioError
-from scripts.stages import STAGES, physics
-from scripts.suite.identity import scenario_hash
-from sim.thresholds import ConfigError
-from synthesis.methods import METHODS
+from avatarsim.avatar_models.fileio import write_atomic, write_json
+from avatarsim.scripts.report_html import render_report
+from avatarsim.scripts.results import ThresholdResult, atomic_dir, junit_xml, versions
+from avatarsim.scripts.run_context import RunContext
+from avatarsim.scripts.scenario import Scenario, ScenarioError
+from avatarsim.scripts.stages import STAGES, physics
+from avatarsim.scripts.suite.identity import scenario_hash
+from avatarsim.sim.thresholds import ConfigError
+from avatarsim.synthesis.methods import METHODS
 
 METRICS: dict[str, str] = {k: v for stage in STAGES for k, v in stage.METRICS.items()}
 

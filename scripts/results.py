@@ -15,10 +15,10 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-from avatar_models.errors import AvatarsimError
-from avatar_models.fileio import dir_mode, write_json
-from scripts.output_file import check_replaceable
-from scripts.scenario import Threshold
+from avatarsim.avatar_models.errors import AvatarsimError
+from avatarsim.avatar_models.fileio import dir_mode, write_json
+from avatarsim.scripts.output_file import check_replaceable
+from avatarsim.scripts.scenario import Threshold
 
 
 @dataclass(frozen=True)

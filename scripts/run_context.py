@@ -8,14 +8,14 @@ from typing import Any
 
 from rich.console import Console
 
-from avatar_models.motion import Motion
-from render_cams.kinect import KinectSkeletonStream
-from render_cams.tracking import TrackingStream
-from scripts.results import ThresholdResult
-from scripts.scenario import Scenario
-from sim.humanoid import Humanoid
-from synthesis.base import TrackingFrame
-from synthesis.controllerpose.synthesizer import KeypointRecording
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.render_cams.kinect import KinectSkeletonStream
+from avatarsim.render_cams.tracking import TrackingStream
+from avatarsim.scripts.results import ThresholdResult
+from avatarsim.scripts.scenario import Scenario
+from avatarsim.sim.humanoid import Humanoid
+from avatarsim.synthesis.base import TrackingFrame
+from avatarsim.synthesis.controllerpose.synthesizer import KeypointRecording
 
 
 @dataclass

@@ -37,10 +37,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
-from avatar_models.config import ConfigError, from_data, read_toml, setting
-from avatar_models.memory import FRAME_BYTES, require_memory
-from avatar_models.motion import FPS_RANGE
-from render_cams.kinect.sensors import SENSORS
+from avatarsim.avatar_models.config import ConfigError, from_data, read_toml, setting
+from avatarsim.avatar_models.memory import FRAME_BYTES, require_memory
+from avatarsim.avatar_models.motion import FPS_RANGE
+from avatarsim.render_cams.kinect.sensors import SENSORS
 
 KINECT_SENSORS = tuple(SENSORS)
 # sim.corrupt's defects a scenario's motion can be given (``motion.corrupt``), each one that a

@@ -3,4 +3,4 @@
 ``avatar_models`` is imported first because it picks the headless GL backend (``MUJOCO_GL``)
 before anything here imports mujoco (:mod:`sim.render` renders offscreen)."""
 
-import avatar_models  # noqa: F401
+import avatarsim.avatar_models  # noqa: F401

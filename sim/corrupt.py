@@ -12,9 +12,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
-from avatar_models.body import BodyDescription
-from avatar_models.motion import Motion
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body import BodyDescription
+from avatarsim.avatar_models.motion import Motion
 
 
 def sink_feet(motion: Motion, depth_m: float = 0.10) -> Motion:

@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.fileio import atomic_file, write_atomic, write_json
-from sim.humanoid import Humanoid
+from avatarsim.avatar_models.fileio import atomic_file, write_atomic, write_json
+from avatarsim.sim.humanoid import Humanoid
 
 MAX_KEYS = 2000  # keyframes in replay.xml; longer clips are subsampled evenly
 

@@ -24,11 +24,11 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from avatar_models.body import BodyDescription, RestPoseNotUprightError, build_body
-from avatar_models.errors import MotionValueError
-from avatar_models.measure import standing_height
-from avatar_models.motion import Motion
-from avatar_models.rigs import identify_rig
+from avatarsim.avatar_models.body import BodyDescription, RestPoseNotUprightError, build_body
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.rigs import identify_rig
 
 DEFAULT_MASS_KG = 75.0
 
@@ -76,7 +76,7 @@ class Humanoid:
     def control_model(self) -> mujoco.MjModel:
         """A new compiled physics-control variant of ``model``
         (:func:`sim.control.model.control_model`): motors, only floor contacts."""
-        from sim.control.model import control_model  # sim.control builds on this module
+        from avatarsim.sim.control.model import control_model  # sim.control builds on this module
 
         return control_model(self.body.spec)
 
@@ -143,7 +143,7 @@ def humanoid_for(
         qpos = body.qpos_from_motion(motion)
         zero = np.zeros(motion.n_frames)
         return Humanoid(body, motion, qpos, zero, motion, body.model)
-    from sim.retarget.sizing import humanoid_body  # IK (mink) is only loaded when needed
+    from avatarsim.sim.retarget.sizing import humanoid_body  # IK (mink) is only loaded when needed
 
     body = humanoid_body(motion, mass_kg=mass_kg)
     return _retargeted(body, motion, body.model, level_feet)
@@ -152,7 +152,7 @@ def humanoid_for(
 def _retargeted(
     body: BodyDescription, motion: Motion, model: mujoco.MjModel, level_feet: bool
 ) -> Humanoid:
-    from sim.retarget import retarget
+    from avatarsim.sim.retarget import retarget
 
     result = retarget(motion, body, level_feet=level_feet, scale_targets=False, model=model)
     meta = {**result.motion.meta, "retarget_residual_cm": float(np.mean(result.residual_cm))}

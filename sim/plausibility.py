@@ -13,12 +13,12 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from avatar_models.body import BodyDescription
-from avatar_models.errors import MotionValueError
-from avatar_models.motion import Motion
-from sim.checks import ALL_CHECKS, BodyReplay, Check, CheckResult
-from sim.humanoid import Humanoid, humanoid_for
-from sim.thresholds import THRESHOLD_KEYS, CheckConfig
+from avatarsim.avatar_models.body import BodyDescription
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.sim.checks import ALL_CHECKS, BodyReplay, Check, CheckResult
+from avatarsim.sim.humanoid import Humanoid, humanoid_for
+from avatarsim.sim.thresholds import THRESHOLD_KEYS, CheckConfig
 
 CONTRACT_KEYS = (
     "penetration_cm_p95",

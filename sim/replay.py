@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.errors import MotionValueError
 
 
 @dataclass(frozen=True)

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from avatar_models.fileio import write_columns_csv, write_json
-from sim.plausibility import PlausibilityReport
+from avatarsim.avatar_models.fileio import write_columns_csv, write_json
+from avatarsim.sim.plausibility import PlausibilityReport
 
 
 def summary_rows(report: PlausibilityReport) -> list[tuple[str, float, float, bool]]:

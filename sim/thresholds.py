@@ -77,7 +77,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
-from avatar_models.config import ConfigError, from_data, read_toml, setting
+from avatarsim.avatar_models.config import ConfigError, from_data, read_toml, setting
 
 
 @dataclass(frozen=True)

@@ -3,7 +3,7 @@ a :class:`~synthesis.base.Synthesizer` (one core over a batch of frames, ``advan
 ``reset``/``step`` and batch ``run`` both call it). :mod:`synthesis.scoring` runs and scores
 any of them; :mod:`synthesis.evaluate` holds the accuracy protocols."""
 
-from synthesis.base import (
+from avatarsim.synthesis.base import (
     FrameBatch,
     Pose,
     Poses,

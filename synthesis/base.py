@@ -34,8 +34,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import AvatarsimError, Motion, Skeleton, quat
-from render_cams import TrackingStream
+from avatarsim.avatar_models import AvatarsimError, Motion, Skeleton, quat
+from avatarsim.render_cams import TrackingStream
 
 DEFAULT_RATE_HZ = 90.0
 

@@ -36,14 +36,14 @@ import mujoco
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from avatar_models import Motion, Skeleton, body17, quat
-from avatar_models.body import build_body
-from avatar_models.body.ik import HumanoidIK, IKSettings, humanoid_model, motion_from_qpos
-from avatar_models.measure import standing_height
-from avatar_models.rigs import identify_rig
-from render_cams import TrackingStream
-from render_cams.vr import HEADSET_AND_CONTROLLERS, Attachment, nominal_attachment
-from synthesis.base import DEFAULT_RATE_HZ, FrameBatch, Poses, SynthesisError, Synthesizer
+from avatarsim.avatar_models import Motion, Skeleton, body17, quat
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.body.ik import HumanoidIK, IKSettings, humanoid_model, motion_from_qpos
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.rigs import identify_rig
+from avatarsim.render_cams import TrackingStream
+from avatarsim.render_cams.vr import HEADSET_AND_CONTROLLERS, Attachment, nominal_attachment
+from avatarsim.synthesis.base import DEFAULT_RATE_HZ, FrameBatch, Poses, SynthesisError, Synthesizer
 
 STEERED_SITES = ("head", "l_wrist", "r_wrist", "pelvis", "l_ankle", "r_ankle")
 """The humanoid's body17 sites the IK steers, in target order."""

@@ -16,21 +16,21 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 
-from avatar_models import Skeleton
-from render_cams.kinect import KinectSkeletonStream
-from render_cams.vr import Attachment
-from synthesis.avatargo import AvatarGo
-from synthesis.base import SynthesisError, Synthesizer, TrackingFrame
-from synthesis.controllerpose.synthesizer import (
+from avatarsim.avatar_models import Skeleton
+from avatarsim.render_cams.kinect import KinectSkeletonStream
+from avatarsim.render_cams.vr import Attachment
+from avatarsim.synthesis.avatargo import AvatarGo
+from avatarsim.synthesis.base import SynthesisError, Synthesizer, TrackingFrame
+from avatarsim.synthesis.controllerpose.synthesizer import (
     ControllerPose,
     KeypointRecording,
     default_checkpoint,
     model_missing,
 )
-from synthesis.coolmoves import CoolMoves, Database, Options
-from synthesis.ik_baseline import IKBaseline
-from synthesis.movebox import MoveBox
-from synthesis.movebox.resize import avatar_for
+from avatarsim.synthesis.coolmoves import CoolMoves, Database, Options
+from avatarsim.synthesis.ik_baseline import IKBaseline
+from avatarsim.synthesis.movebox import MoveBox
+from avatarsim.synthesis.movebox.resize import avatar_for
 
 
 @dataclass(eq=False)

@@ -32,14 +32,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import Motion, body17
-from avatar_models.rigs import body17_positions
-from render_cams import TrackingStream
-from render_cams.device import motion_at_rate
-from synthesis.base import SynthesisError, Synthesizer, TrackingFrame, on_clock, usable_mask
-from synthesis.coolmoves.correlation import pearson
-from synthesis.coolmoves.database import HANDS_DRIVE, Drivers, driver_positions
-from synthesis.coolmoves.features import WINDOW_SAMPLES
+from avatarsim.avatar_models import Motion, body17
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams import TrackingStream
+from avatarsim.render_cams.device import motion_at_rate
+from avatarsim.synthesis.base import (
+    SynthesisError,
+    Synthesizer,
+    TrackingFrame,
+    on_clock,
+    usable_mask,
+)
+from avatarsim.synthesis.coolmoves.correlation import pearson
+from avatarsim.synthesis.coolmoves.database import HANDS_DRIVE, Drivers, driver_positions
+from avatarsim.synthesis.coolmoves.features import WINDOW_SAMPLES
 
 WARM_UP = WINDOW_SAMPLES - 1
 STILL_AXIS_M = 1e-3

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import quat
+from avatarsim.avatar_models import quat
 
 _EPS = 1e-12
 _X, _Z = np.array([1.0, 0.0, 0.0]), np.array([0.0, 0.0, 1.0])

@@ -16,7 +16,7 @@ from types import ModuleType
 
 import pytest
 
-import avatar_models  # noqa: F401  (picks the headless GL backend before any GL import)
+import avatarsim.avatar_models  # noqa: F401  (picks the headless GL backend before any GL import)
 
 MOCAP_DIR = Path(
     os.environ.get(

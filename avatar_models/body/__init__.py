@@ -11,11 +11,11 @@ and ``to_trimesh(...)`` the same primitives posed for one frame. MuJoCo is impor
 :mod:`avatar_models.body.mjcf`, :mod:`avatar_models.body.control` and the IK.
 """
 
-from avatar_models.body.control import control_spec
-from avatar_models.body.description import BodyDescription, build_body
-from avatar_models.body.errors import BodyError, RestPoseNotUprightError
-from avatar_models.body.geometry import Segment
-from avatar_models.body.mjcf import hinge_name
+from avatarsim.avatar_models.body.control import control_spec
+from avatarsim.avatar_models.body.description import BodyDescription, build_body
+from avatarsim.avatar_models.body.errors import BodyError, RestPoseNotUprightError
+from avatarsim.avatar_models.body.geometry import Segment
+from avatarsim.avatar_models.body.mjcf import hinge_name
 
 __all__ = [
     "BodyDescription",

@@ -15,8 +15,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models.rigs import Rig
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models.rigs import Rig
+from avatarsim.avatar_models.skeleton import Skeleton
 
 # The body17 joints of a limb; each names the role of the joints from it down to the next.
 _LIMB_JOINTS = {"leg": ("hip", "knee", "ankle"), "arm": ("shoulder", "elbow", "wrist")}

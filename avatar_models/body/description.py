@@ -17,16 +17,16 @@ from functools import cached_property
 
 import numpy as np
 
-from avatar_models.body import anthropometry as anthro
-from avatar_models.body.anatomy import Anatomy, classify
-from avatar_models.body.errors import BodyError, RestPoseNotUprightError
-from avatar_models.body.geometry import Segment
-from avatar_models.body.joint_ranges import euler_order, is_shared, joint_ranges
-from avatar_models.body.layout import Layout
-from avatar_models.errors import RigError
-from avatar_models.motion import Motion
-from avatar_models.rigs import Rig, identify_rig
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models.body import anthropometry as anthro
+from avatarsim.avatar_models.body.anatomy import Anatomy, classify
+from avatarsim.avatar_models.body.errors import BodyError, RestPoseNotUprightError
+from avatarsim.avatar_models.body.geometry import Segment
+from avatarsim.avatar_models.body.joint_ranges import euler_order, is_shared, joint_ranges
+from avatarsim.avatar_models.body.layout import Layout
+from avatarsim.avatar_models.errors import RigError
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.rigs import Rig, identify_rig
+from avatarsim.avatar_models.skeleton import Skeleton
 
 MAX_HEIGHT_M = 3.0
 FOOT_SHAPES = ("box", "capsule")
@@ -137,7 +137,7 @@ class BodyDescription:
     @cached_property
     def mesh_template(self):
         """Primitives tessellated in body frames (a :class:`~.mesh.MeshTemplate`)."""
-        from avatar_models.body.mesh import mesh_template
+        from avatarsim.avatar_models.body.mesh import mesh_template
 
         return mesh_template(self.segments)
 
@@ -146,7 +146,7 @@ class BodyDescription:
     def spec(self):
         """The body's :class:`mujoco.MjSpec` (see :mod:`avatar_models.body.mjcf`), built once
         and shared: edit a ``spec.copy()`` (e.g. :func:`~avatar_models.body.control_spec`)."""
-        from avatar_models.body.mjcf import body_spec
+        from avatarsim.avatar_models.body.mjcf import body_spec
 
         return body_spec(self)
 
@@ -163,7 +163,7 @@ class BodyDescription:
 
     def qpos_from_motion(self, motion: Motion) -> np.ndarray:
         """``(T, nq)`` MuJoCo qpos for ``motion`` (see :mod:`avatar_models.body.qpos`)."""
-        from avatar_models.body.qpos import qpos_from_motion
+        from avatarsim.avatar_models.body.qpos import qpos_from_motion
 
         return qpos_from_motion(self, motion)
 
@@ -173,7 +173,7 @@ class BodyDescription:
         ``pose`` is either global joint positions ``(J, 3)`` with ``global_rot`` ``(J, 3, 3)``
         rotation matrices or ``(J, 4)`` wxyz quaternions, or a :class:`Motion` and ``frame``.
         """
-        from avatar_models.body.mesh import posed_mesh
+        from avatarsim.avatar_models.body.mesh import posed_mesh
 
         return posed_mesh(self, pose, global_rot, frame)
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from avatar_models.errors import AvatarsimError
+from avatarsim.avatar_models.errors import AvatarsimError
 
 
 class BodyError(AvatarsimError, ValueError):

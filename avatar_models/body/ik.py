@@ -32,10 +32,10 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 from threadpoolctl import threadpool_limits
 
-from avatar_models import quat
-from avatar_models.body.description import BodyDescription
-from avatar_models.body.errors import BodyError
-from avatar_models.motion import Motion
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body.description import BodyDescription
+from avatarsim.avatar_models.body.errors import BodyError
+from avatarsim.avatar_models.motion import Motion
 
 SOLVER = "daqp"
 ROOT_NQ = 7

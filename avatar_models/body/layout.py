@@ -16,11 +16,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from avatar_models.body import anthropometry as anthro
-from avatar_models.body.anatomy import Anatomy
-from avatar_models.body.errors import BodyError
-from avatar_models.body.geometry import Segment
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models.body import anthropometry as anthro
+from avatarsim.avatar_models.body.anatomy import Anatomy
+from avatarsim.avatar_models.body.errors import BodyError
+from avatarsim.avatar_models.body.geometry import Segment
+from avatarsim.avatar_models.skeleton import Skeleton
 
 CAPS_INSIDE = {"upper_arm": (True, False), "shank": (False, True)}
 """Segment kind -> (proximal, distal) caps that end at the joint rather than around it: the

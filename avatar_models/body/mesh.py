@@ -11,10 +11,10 @@ from dataclasses import dataclass
 import numpy as np
 import trimesh
 
-from avatar_models import quat
-from avatar_models.body.errors import BodyError
-from avatar_models.body.geometry import Segment
-from avatar_models.motion import Motion
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body.errors import BodyError
+from avatarsim.avatar_models.body.geometry import Segment
+from avatarsim.avatar_models.motion import Motion
 
 CAPSULE_COUNT = (16, 16)
 SPHERE_SUBDIVISIONS = 2

@@ -33,8 +33,8 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from avatar_models.body.description import BodyDescription
-from avatar_models.body.geometry import Segment, combined_inertial
+from avatarsim.avatar_models.body.description import BodyDescription
+from avatarsim.avatar_models.body.geometry import Segment, combined_inertial
 
 GRAVITY = 9.81
 STIFFNESS_MARGIN = 4.0

@@ -18,10 +18,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import quat
-from avatar_models.body.description import BodyDescription
-from avatar_models.body.errors import BodyError
-from avatar_models.motion import Motion
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body.description import BodyDescription
+from avatarsim.avatar_models.body.errors import BodyError
+from avatarsim.avatar_models.motion import Motion
 
 
 def _forearm_takes_wrist_twist(desc: BodyDescription, local_rot: np.ndarray) -> np.ndarray:

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from avatar_models.errors import MotionFormatError
-from avatar_models.motion import Motion
-from avatar_models.motion_bounds import check_physical
+from avatarsim.avatar_models.errors import MotionFormatError
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.motion_bounds import check_physical
 
 READABLE = (".bvh", ".amc", ".npz")
 WRITABLE = (".bvh", ".npz")
@@ -38,15 +38,15 @@ def _read_motion(path: Path, **options) -> Motion:
     if not path.is_file():
         raise MotionFormatError("no such file", path)
     if suffix == ".bvh":
-        from avatar_models.formats.bvh import read_bvh
+        from avatarsim.avatar_models.formats.bvh import read_bvh
 
         return read_bvh(path, **options)
     if suffix == ".amc":
-        from avatar_models.formats.asf_amc import read_asf_amc
+        from avatarsim.avatar_models.formats.asf_amc import read_asf_amc
 
         return read_asf_amc(path, **options)
     if suffix == ".npz":
-        from avatar_models.formats.npz import read_npz
+        from avatarsim.avatar_models.formats.npz import read_npz
 
         if options:
             raise MotionFormatError(
@@ -72,11 +72,11 @@ def save_motion(motion: Motion, path: str | Path, **options) -> Path:
 def _save_motion(motion: Motion, path: Path, **options) -> Path:
     suffix = path.suffix.lower()
     if suffix == ".bvh":
-        from avatar_models.formats.bvh import write_bvh
+        from avatarsim.avatar_models.formats.bvh import write_bvh
 
         return write_bvh(motion, path, **options)
     if suffix == ".npz":
-        from avatar_models.formats.npz import write_npz
+        from avatarsim.avatar_models.formats.npz import write_npz
 
         return write_npz(motion, path, **options)
     raise MotionFormatError(f"cannot write {suffix!r}; writable: {', '.join(WRITABLE)}", path)

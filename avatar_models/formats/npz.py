@@ -14,10 +14,10 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.errors import MotionFormatError, MotionValueError
-from avatar_models.fileio import atomic_file
-from avatar_models.motion import Motion
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models.errors import MotionFormatError, MotionValueError
+from avatarsim.avatar_models.fileio import atomic_file
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.skeleton import Skeleton
 
 FORMAT_VERSION = 1
 _KEYS = ("version", "names", "parents", "offsets", "is_site", "fps", "root_pos", "local_rot")

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.errors import MotionFormatError
+from avatarsim.avatar_models.errors import MotionFormatError
 
 UNITS: dict[str, float] = {
     "m": 1.0,

@@ -15,11 +15,17 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from avatar_models.errors import MotionValueError
-from avatar_models.generator import boxing, exercises, ladder, locomotion, study, swim
-from avatar_models.generator.plan import Plan, Scene, realise
-from avatar_models.generator.subject import STYLES, Style, Subject, sample_subject, subject_skeleton
-from avatar_models.motion import Motion
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.generator import boxing, exercises, ladder, locomotion, study, swim
+from avatarsim.avatar_models.generator.plan import Plan, Scene, realise
+from avatarsim.avatar_models.generator.subject import (
+    STYLES,
+    Style,
+    Subject,
+    sample_subject,
+    subject_skeleton,
+)
+from avatarsim.avatar_models.motion import Motion
 
 _ACTIVITY_PLANS: dict[str, Callable[[Scene], Plan]] = {
     "walk": locomotion.walk,
@@ -80,7 +86,7 @@ def generate(
     plan = _ACTIVITY_PLANS[activity](scene)
     motion = realise(scene, plan)
     meta = {
-        "generator": "avatar_models.generator",
+        "generator": "avatarsim.avatar_models.generator",
         "activity": activity,
         "seed": int(seed),
         "subject": subject.as_dict(),

@@ -12,11 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.generator.curves import keyframes
-from avatar_models.generator.feet import FootGeometry, planted
-from avatar_models.generator.ik import axis_rotation
-from avatar_models.generator.plan import LimbTarget, Plan, Scene
-from avatar_models.generator.poses import Y_AXIS, gaze, heading_rotation, trunk
+from avatarsim.avatar_models.generator.curves import keyframes
+from avatarsim.avatar_models.generator.feet import FootGeometry, planted
+from avatarsim.avatar_models.generator.ik import axis_rotation
+from avatarsim.avatar_models.generator.plan import LimbTarget, Plan, Scene
+from avatarsim.avatar_models.generator.poses import Y_AXIS, gaze, heading_rotation, trunk
 
 STANCE_YAW = np.radians(-20.0)
 

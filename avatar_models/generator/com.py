@@ -15,11 +15,11 @@ from functools import cache
 import numpy as np
 from scipy.linalg import solve_banded
 
-from avatar_models.body import build_body
-from avatar_models.generator.bounce import GRAVITY_M_S2
-from avatar_models.generator.plan import Plan, Scene, realise_local
-from avatar_models.motion import Motion, forward_kinematics
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.generator.bounce import GRAVITY_M_S2
+from avatarsim.avatar_models.generator.plan import Plan, Scene, realise_local
+from avatarsim.avatar_models.motion import Motion, forward_kinematics
+from avatarsim.avatar_models.skeleton import Skeleton
 
 
 @dataclass(frozen=True)

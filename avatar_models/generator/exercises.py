@@ -9,16 +9,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.generator.curves import keyframes, phase, smoothstep, window
-from avatar_models.generator.feet import (
+from avatarsim.avatar_models.generator.curves import keyframes, phase, smoothstep, window
+from avatarsim.avatar_models.generator.feet import (
     FootGeometry,
     FootTrack,
     foot_pose,
     swing_between,
 )
-from avatar_models.generator.ik import axis_rotation, euler
-from avatar_models.generator.plan import LimbTarget, Plan, Scene, sided
-from avatar_models.generator.poses import (
+from avatarsim.avatar_models.generator.ik import axis_rotation, euler
+from avatarsim.avatar_models.generator.plan import LimbTarget, Plan, Scene, sided
+from avatarsim.avatar_models.generator.poses import (
     X_AXIS,
     Y_AXIS,
     Z_AXIS,
@@ -27,7 +27,12 @@ from avatar_models.generator.poses import (
     heading_rotation,
     trunk,
 )
-from avatar_models.generator.standing import home_ankles, leg_targets, planted_feet, reachable_root
+from avatarsim.avatar_models.generator.standing import (
+    home_ankles,
+    leg_targets,
+    planted_feet,
+    reachable_root,
+)
 
 TAU = 2.0 * np.pi
 

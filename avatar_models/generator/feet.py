@@ -14,9 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models.generator.curves import bump, phase, smoothstep, swing_progress, window
-from avatar_models.generator.ik import axis_rotation
-from avatar_models.generator.plan import Scene
+from avatarsim.avatar_models.generator.curves import bump, phase, smoothstep, swing_progress, window
+from avatarsim.avatar_models.generator.ik import axis_rotation
+from avatarsim.avatar_models.generator.plan import Scene
 
 Y_AXIS = np.array([0.0, 1.0, 0.0])
 # Stance sub-phases of a walking foot as fractions of stance: heel rocker until 0.15, flat

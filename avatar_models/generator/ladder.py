@@ -11,11 +11,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.generator.curves import bump, phase, swing_progress, window
-from avatar_models.generator.feet import SWING_LIFT, FootGeometry, FootTrack
-from avatar_models.generator.plan import LimbTarget, Plan, Scene
-from avatar_models.generator.poses import gaze, heading_rotation, trunk
-from avatar_models.generator.standing import leg_targets, reachable_root
+from avatarsim.avatar_models.generator.curves import bump, phase, swing_progress, window
+from avatarsim.avatar_models.generator.feet import SWING_LIFT, FootGeometry, FootTrack
+from avatarsim.avatar_models.generator.plan import LimbTarget, Plan, Scene
+from avatarsim.avatar_models.generator.poses import gaze, heading_rotation, trunk
+from avatarsim.avatar_models.generator.standing import leg_targets, reachable_root
 
 RUNG_SPACING_M = 0.305
 # Fractions of the climbing cycle: the left foot and right hand move, then the right foot

@@ -25,23 +25,23 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from avatar_models.generator.bounce import spring_mass_bounce, vaulting_bob
-from avatar_models.generator.com import (
+from avatarsim.avatar_models.generator.bounce import spring_mass_bounce, vaulting_bob
+from avatarsim.avatar_models.generator.com import (
     follow_centre_of_mass,
     lipm_centre_of_mass,
     plan_centre_of_mass,
 )
-from avatar_models.generator.curves import smooth_cap, smoothstep
-from avatar_models.generator.feet import (
+from avatarsim.avatar_models.generator.curves import smooth_cap, smoothstep
+from avatarsim.avatar_models.generator.feet import (
     SWING_LIFT,
     centre_of_pressure,
     gait_track,
     pelvis_height_limit,
 )
-from avatar_models.generator.ik import euler
-from avatar_models.generator.plan import LimbTarget, Plan, Scene
-from avatar_models.generator.poses import arm_angles, gaze, heading_rotation, trunk
-from avatar_models.generator.standing import CAP_HALF_WIDTH_S
+from avatarsim.avatar_models.generator.ik import euler
+from avatarsim.avatar_models.generator.plan import LimbTarget, Plan, Scene
+from avatarsim.avatar_models.generator.poses import arm_angles, gaze, heading_rotation, trunk
+from avatarsim.avatar_models.generator.standing import CAP_HALF_WIDTH_S
 
 TAU = 2.0 * np.pi
 PENDULUM_PAD_S = 1.5  # exp(-omega * 1.5 s) < 1% for a centre of mass under 1.2 m

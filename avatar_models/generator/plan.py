@@ -14,11 +14,16 @@ from typing import Any
 
 import numpy as np
 
-from avatar_models import quat
-from avatar_models.generator.ik import axis_rotation, scale_rotation, twist_about, two_bone_ik
-from avatar_models.generator.subject import Style, Subject
-from avatar_models.motion import Motion, forward_kinematics
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.generator.ik import (
+    axis_rotation,
+    scale_rotation,
+    twist_about,
+    two_bone_ik,
+)
+from avatarsim.avatar_models.generator.subject import Style, Subject
+from avatarsim.avatar_models.motion import Motion, forward_kinematics
+from avatarsim.avatar_models.skeleton import Skeleton
 
 SIDES = ("L", "R")
 # Reflection across the sagittal plane; M R M is the mirror image of a rotation R.

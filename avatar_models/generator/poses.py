@@ -8,8 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.generator.ik import axis_rotation, euler
-from avatar_models.generator.plan import Scene, sided
+from avatarsim.avatar_models.generator.ik import axis_rotation, euler
+from avatarsim.avatar_models.generator.plan import Scene, sided
 
 X_AXIS, Y_AXIS, Z_AXIS = np.eye(3)
 

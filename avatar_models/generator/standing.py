@@ -4,9 +4,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.generator.curves import smooth_cap
-from avatar_models.generator.feet import FootGeometry, FootTrack, pelvis_height_limit, planted
-from avatar_models.generator.plan import LimbTarget, Scene
+from avatarsim.avatar_models.generator.curves import smooth_cap
+from avatarsim.avatar_models.generator.feet import (
+    FootGeometry,
+    FootTrack,
+    pelvis_height_limit,
+    planted,
+)
+from avatarsim.avatar_models.generator.plan import LimbTarget, Scene
 
 # Half-width of the window over which the pelvis lowers ahead of a foot it must reach: wide
 # enough that the lowering takes a few tenths of a second (well under 1 g), like a person

@@ -30,12 +30,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models.generator.curves import keyframes, smoothstep
-from avatar_models.generator.feet import FootTrack
-from avatar_models.generator.ik import axis_rotation
-from avatar_models.generator.plan import LimbTarget, Plan, Scene, realise
-from avatar_models.generator.poses import Y_AXIS, gaze, heading_rotation, trunk
-from avatar_models.generator.standing import home_ankles, leg_targets, reachable_root
+from avatarsim.avatar_models.generator.curves import keyframes, smoothstep
+from avatarsim.avatar_models.generator.feet import FootTrack
+from avatarsim.avatar_models.generator.ik import axis_rotation
+from avatarsim.avatar_models.generator.plan import LimbTarget, Plan, Scene, realise
+from avatarsim.avatar_models.generator.poses import Y_AXIS, gaze, heading_rotation, trunk
+from avatarsim.avatar_models.generator.standing import home_ankles, leg_targets, reachable_root
 
 REFERENCE_HEIGHT_M = 1.75
 VOLUME_CM = (69.0, 51.0, 22.0)  # width, height, depth of the sphere volume (§5.1)

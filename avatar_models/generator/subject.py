@@ -13,9 +13,9 @@ from functools import cache
 
 import numpy as np
 
-from avatar_models.errors import MotionValueError
-from avatar_models.rigs import load_rig
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.avatar_models.skeleton import Skeleton
 
 HEIGHT_RANGE_M = (1.5, 1.95)
 

@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.generator.ik import axis_rotation
-from avatar_models.generator.plan import LimbTarget, Plan, Scene, realise
-from avatar_models.generator.poses import X_AXIS, Y_AXIS
+from avatarsim.avatar_models.generator.ik import axis_rotation
+from avatarsim.avatar_models.generator.plan import LimbTarget, Plan, Scene, realise
+from avatarsim.avatar_models.generator.poses import X_AXIS, Y_AXIS
 
 TAU = 2.0 * np.pi
 

@@ -25,7 +25,7 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from render_cams.device import DeviceError
+from avatarsim.render_cams.device import DeviceError
 
 BAD_FRAME_RATE = 1.0 / 50.0  # ControllerPose §4.2
 KINDS = ("noise_band", "tearing", "black")

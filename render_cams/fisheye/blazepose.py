@@ -45,8 +45,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from avatar_models.body17 import BODY17
-from render_cams.fisheye.pose_detector import (
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.render_cams.fisheye.pose_detector import (
     DetectorError,
     Keypoints2D,
     ViewTruth,

@@ -26,8 +26,8 @@ import cv2
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from avatar_models import CalibrationError
-from render_cams.fisheye.model import FisheyeModel
+from avatarsim.avatar_models import CalibrationError
+from avatarsim.render_cams.fisheye.model import FisheyeModel
 
 PATTERN = (9, 6)  # inner corners (columns, rows), OpenCV's calibration sample
 SQUARE_M = 0.025

@@ -48,9 +48,9 @@ from typing import ClassVar
 
 import numpy as np
 
-from avatar_models.body17 import BODY17, INDEX
-from render_cams.device import DeviceError
-from render_cams.fisheye.pose_detector import Keypoints2D, ViewTruth, check_image
+from avatarsim.avatar_models.body17 import BODY17, INDEX
+from avatarsim.render_cams.device import DeviceError
+from avatarsim.render_cams.fisheye.pose_detector import Keypoints2D, ViewTruth, check_image
 
 # COCO keypoint OKS sigmas (cocoapi, pycocotools/cocoeval.py) by COCO keypoint name, plus
 # the mean of COCO-WholeBody's left and right big toe (0.068, 0.092).

@@ -27,31 +27,31 @@ from typing import Any
 
 import numpy as np
 
-from avatar_models import Motion
-from avatar_models.body import BodyDescription
-from avatar_models.rigs import body17_positions
-from render_cams.device import DeviceError, check_rate, motion_at_rate, resolve_seed
-from render_cams.fisheye import bad_frames, occlusion
-from render_cams.fisheye.detector import ErrorModelDetector
-from render_cams.fisheye.keypoints import (
+from avatarsim.avatar_models import Motion
+from avatarsim.avatar_models.body import BodyDescription
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams.device import DeviceError, check_rate, motion_at_rate, resolve_seed
+from avatarsim.render_cams.fisheye import bad_frames, occlusion
+from avatarsim.render_cams.fisheye.detector import ErrorModelDetector
+from avatarsim.render_cams.fisheye.keypoints import (
     confidence,
     joint_thickness,
     project_joints,
     visibility,
     world_to_camera,
 )
-from render_cams.fisheye.model import FisheyeModel
-from render_cams.fisheye.pose2d import ControllerPose2D, controller_views
-from render_cams.fisheye.records import frame_record
-from render_cams.fisheye.render import FisheyeRenderer
-from render_cams.fisheye.rig import (
+from avatarsim.render_cams.fisheye.model import FisheyeModel
+from avatarsim.render_cams.fisheye.pose2d import ControllerPose2D, controller_views
+from avatarsim.render_cams.fisheye.records import frame_record
+from avatarsim.render_cams.fisheye.render import FisheyeRenderer
+from avatarsim.render_cams.fisheye.rig import (
     ControllerCamera,
     Mount,
     camera_poses,
     controller_cameras,
     inside_body,
 )
-from render_cams.scene import BodyScene, body_for_motion
+from avatarsim.render_cams.scene import BodyScene, body_for_motion
 
 CAMERA_RATE_HZ = 30.0
 SCALE_RANGE = (0.05, 4.0)  # image size factors for quick looks (0.125: 80x60)

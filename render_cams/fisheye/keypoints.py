@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.body import BodyDescription
-from render_cams.fisheye.model import HALF_PI, FisheyeModel
+from avatarsim.avatar_models.body import BodyDescription
+from avatarsim.render_cams.fisheye.model import HALF_PI, FisheyeModel
 
 OCCLUDED_CONFIDENCE = 0.1
 RIM_CONFIDENCE = 0.5

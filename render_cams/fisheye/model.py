@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from avatar_models import AvatarsimError
+from avatarsim.avatar_models import AvatarsimError
 
 MODEL_NAME = "opencv_fisheye"
 PAPER_SIZE = (640, 480)  # ControllerPose §4.1

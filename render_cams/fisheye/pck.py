@@ -18,8 +18,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from avatar_models.body17 import INDEX, MIRROR
-from render_cams.fisheye.pose_detector import Keypoints2D, ViewTruth
+from avatarsim.avatar_models.body17 import INDEX, MIRROR
+from avatarsim.render_cams.fisheye.pose_detector import Keypoints2D, ViewTruth
 
 PCK_FRACTION = 0.2
 

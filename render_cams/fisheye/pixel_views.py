@@ -18,9 +18,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from render_cams.fisheye.pose2d import inside
-from render_cams.fisheye.pose_detector import Keypoints2D, PoseDetector, ViewTruth, no_person
-from render_cams.fisheye.torso_view import TorsoView, apply_homography, torso_view
+from avatarsim.render_cams.fisheye.pose2d import inside
+from avatarsim.render_cams.fisheye.pose_detector import (
+    Keypoints2D,
+    PoseDetector,
+    ViewTruth,
+    no_person,
+)
+from avatarsim.render_cams.fisheye.torso_view import TorsoView, apply_homography, torso_view
 
 
 @dataclass(frozen=True)

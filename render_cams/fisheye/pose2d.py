@@ -19,11 +19,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from render_cams.fisheye.detector import Detection, ErrorModelDetector
-from render_cams.fisheye.model import FisheyeModel
-from render_cams.fisheye.rig import ControllerCamera, camera_pairs
-from render_cams.fisheye.stitch import StitchParams, stitch_params
-from render_cams.fisheye.torso_view import TorsoView, apply_homography, torso_view
+from avatarsim.render_cams.fisheye.detector import Detection, ErrorModelDetector
+from avatarsim.render_cams.fisheye.model import FisheyeModel
+from avatarsim.render_cams.fisheye.rig import ControllerCamera, camera_pairs
+from avatarsim.render_cams.fisheye.stitch import StitchParams, stitch_params
+from avatarsim.render_cams.fisheye.torso_view import TorsoView, apply_homography, torso_view
 
 
 @dataclass(frozen=True)

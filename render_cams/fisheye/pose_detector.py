@@ -21,8 +21,8 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from avatar_models import AvatarsimError
-from avatar_models.body17 import BODY17
+from avatarsim.avatar_models import AvatarsimError
+from avatarsim.avatar_models.body17 import BODY17
 
 N_JOINTS = len(BODY17)
 

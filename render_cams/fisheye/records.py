@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.body17 import BODY17
-from render_cams.fisheye.model import FisheyeModel
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.render_cams.fisheye.model import FisheyeModel
 
 
 def frame_record(

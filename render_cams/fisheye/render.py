@@ -25,8 +25,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from render_cams.fisheye.model import FisheyeModel
-from render_cams.scene import BodyScene
+from avatarsim.render_cams.fisheye.model import FisheyeModel
+from avatarsim.render_cams.scene import BodyScene
 
 # Face camera axes (columns x, y, z) in the fisheye camera frame, OpenCV convention.
 _FACES: dict[str, np.ndarray] = {

@@ -24,9 +24,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import AvatarsimError, Motion, quat
-from avatar_models.body import BodyDescription
-from render_cams.vr import Attachment, attachment_poses, nominal_attachment
+from avatarsim.avatar_models import AvatarsimError, Motion, quat
+from avatarsim.avatar_models.body import BodyDescription
+from avatarsim.render_cams.vr import Attachment, attachment_poses, nominal_attachment
 
 COMPOSITE_VERTICAL_FOV_DEG = 185.0  # ControllerPose §4.1
 CAMERA_VERTICAL_FOV_DEG = 120.0  # ControllerPose §4.1

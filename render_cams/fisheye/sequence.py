@@ -27,11 +27,11 @@ import cv2
 import imageio.v2 as imageio
 import numpy as np
 
-from render_cams.fisheye.device import FisheyeRecording
-from render_cams.fisheye.pose2d import ControllerPose2D
-from render_cams.fisheye.records import detection_fields
-from render_cams.fisheye.rig import camera_pairs
-from render_cams.fisheye.stitch import stitch_params
+from avatarsim.render_cams.fisheye.device import FisheyeRecording
+from avatarsim.render_cams.fisheye.pose2d import ControllerPose2D
+from avatarsim.render_cams.fisheye.records import detection_fields
+from avatarsim.render_cams.fisheye.rig import camera_pairs
+from avatarsim.render_cams.fisheye.stitch import stitch_params
 
 
 def write_fisheye_recording(

@@ -41,8 +41,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from render_cams.fisheye.model import FisheyeModel
-from render_cams.fisheye.rig import ControllerCamera
+from avatarsim.render_cams.fisheye.model import FisheyeModel
+from avatarsim.render_cams.fisheye.rig import ControllerCamera
 
 STITCH_DISTANCE_M = 0.43  # ControllerPose §3: mean camera-to-body distance
 MAX_HALF_WIDTH_DEG = 75.0  # half of the composite's 150 deg horizontal field of view (§4.2)

@@ -27,8 +27,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from avatar_models import AvatarsimError
-from avatar_models.body17 import INDEX
+from avatarsim.avatar_models import AvatarsimError
+from avatarsim.avatar_models.body17 import INDEX
 
 TORSO_CORNERS = ("l_shoulder", "r_shoulder", "r_hip", "l_hip")  # the four points, in order
 CORNER_INDICES = np.array([INDEX[n] for n in TORSO_CORNERS])

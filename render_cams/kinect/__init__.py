@@ -10,17 +10,17 @@ and 30 Hz skeleton streams (issue 4, item 6).
 - :mod:`.sequence`: a recording on disk (depth, body index, skeleton JSON, preview).
 """
 
-from render_cams.kinect.device import Kinect, KinectRecording
-from render_cams.kinect.noise import DepthNoiseModel
-from render_cams.kinect.placement import (
+from avatarsim.render_cams.kinect.device import Kinect, KinectRecording
+from avatarsim.render_cams.kinect.noise import DepthNoiseModel
+from avatarsim.render_cams.kinect.placement import (
     KinectPlacementError,
     default_sensor_pose,
     look_at,
     yaw_pitch_pose,
 )
-from render_cams.kinect.sensors import SENSORS, DepthSensor, KinectError, get_sensor
-from render_cams.kinect.sequence import read_kinect_skeleton, write_kinect_recording
-from render_cams.kinect.skeleton import (
+from avatarsim.render_cams.kinect.sensors import SENSORS, DepthSensor, KinectError, get_sensor
+from avatarsim.render_cams.kinect.sequence import read_kinect_skeleton, write_kinect_recording
+from avatarsim.render_cams.kinect.skeleton import (
     KinectSkeletonStream,
     SkeletonNoise,
     TrackingState,

@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import Motion
-from avatar_models.body import BodyDescription
+from avatarsim.avatar_models import Motion
+from avatarsim.avatar_models.body import BodyDescription
 
 
 @dataclass(frozen=True)

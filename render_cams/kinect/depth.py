@@ -15,10 +15,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from render_cams.kinect.noise import DepthNoiseModel
-from render_cams.kinect.parts import part_image
-from render_cams.kinect.sensors import DepthSensor, KinectError, get_sensor
-from render_cams.scene import BodyScene
+from avatarsim.render_cams.kinect.noise import DepthNoiseModel
+from avatarsim.render_cams.kinect.parts import part_image
+from avatarsim.render_cams.kinect.sensors import DepthSensor, KinectError, get_sensor
+from avatarsim.render_cams.scene import BodyScene
 
 BODY_INDEX_NONE = 255
 """Body-index value of pixels without a body (Kinect V2 and Azure Kinect SDKs)."""

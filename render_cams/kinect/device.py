@@ -26,25 +26,25 @@ from typing import Any
 
 import numpy as np
 
-from avatar_models import Motion
-from avatar_models.body import BodyDescription
-from render_cams.device import motion_at_rate, resolve_seed
-from render_cams.kinect.depth import BODY_INDEX_NONE, DepthFrame, KinectDepthCamera
-from render_cams.kinect.placement import (
+from avatarsim.avatar_models import Motion
+from avatarsim.avatar_models.body import BodyDescription
+from avatarsim.render_cams.device import motion_at_rate, resolve_seed
+from avatarsim.render_cams.kinect.depth import BODY_INDEX_NONE, DepthFrame, KinectDepthCamera
+from avatarsim.render_cams.kinect.placement import (
     DEFAULT_HEIGHT_M,
     default_sensor_pose,
     performer_distance,
 )
-from render_cams.kinect.sensors import DepthSensor, KinectError, get_sensor
-from render_cams.kinect.skeleton import (
+from avatarsim.render_cams.kinect.sensors import DepthSensor, KinectError, get_sensor
+from avatarsim.render_cams.kinect.skeleton import (
     ORACLE_NOTE,
     ORACLE_SKELETON,
     KinectSkeletonStream,
     TrackingState,
     kinect_skeleton,
 )
-from render_cams.kinect.tracker import DEFAULT_MODEL, SKELETON_SOURCE, load_tracker, track
-from render_cams.scene import BodyScene, body_for_motion
+from avatarsim.render_cams.kinect.tracker import DEFAULT_MODEL, SKELETON_SOURCE, load_tracker, track
+from avatarsim.render_cams.scene import BodyScene, body_for_motion
 
 
 @dataclass(frozen=True, eq=False)

@@ -18,9 +18,9 @@ from typing import Any
 
 import numpy as np
 
-from avatar_models.fileio import atomic_file
-from render_cams.kinect.features import DepthFeatures
-from render_cams.kinect.sensors import KinectError
+from avatarsim.avatar_models.fileio import atomic_file
+from avatarsim.render_cams.kinect.features import DepthFeatures
+from avatarsim.render_cams.kinect.sensors import KinectError
 
 LEAF = -1
 """Child index of a leaf (scikit-learn's ``TREE_LEAF``)."""

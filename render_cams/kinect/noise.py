@@ -37,7 +37,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from render_cams.device import DeviceError
+from avatarsim.render_cams.device import DeviceError
 
 # 4-neighbour offsets (dv, du) for edge detection; ties go to the first.
 _NEIGHBOURS = ((0, 1), (0, -1), (1, 0), (-1, 0))

@@ -23,10 +23,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.body import BodyDescription
-from avatar_models.body17 import BODY17, INDEX
-from avatar_models.rigs import identify_rig
-from render_cams.scene import BodyScene
+from avatarsim.avatar_models.body import BodyDescription
+from avatarsim.avatar_models.body17 import BODY17, INDEX
+from avatarsim.avatar_models.rigs import identify_rig
+from avatarsim.render_cams.scene import BodyScene
 
 PART_NONE = 0
 """Label of pixels without a body part."""

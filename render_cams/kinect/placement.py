@@ -20,12 +20,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import Motion
-from avatar_models.body import BodyDescription
-from avatar_models.body17 import INDEX
-from avatar_models.rigs import body17_positions
-from render_cams.kinect.capsules import posed_capsules
-from render_cams.kinect.sensors import DepthSensor, KinectError, get_sensor
+from avatarsim.avatar_models import Motion
+from avatarsim.avatar_models.body import BodyDescription
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams.kinect.capsules import posed_capsules
+from avatarsim.render_cams.kinect.sensors import DepthSensor, KinectError, get_sensor
 
 DEFAULT_HEIGHT_M = 0.9
 """Height of the sensor above the floor. Microsoft's placement guidance for the Kinect

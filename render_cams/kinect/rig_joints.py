@@ -17,9 +17,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import Motion, quat
-from avatar_models.body17 import INDEX
-from avatar_models.rigs import Rig, identify_rig
+from avatarsim.avatar_models import Motion, quat
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.avatar_models.rigs import Rig, identify_rig
 
 # body17 joint -> the body17 segment (from, to) that sets its direction and length scale.
 _REFERENCE_SEGMENT = {

@@ -21,10 +21,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from render_cams.device import DeviceError
-from render_cams.kinect.noise import AZURE_KINECT_NOISE, KINECT_V2_NOISE, DepthNoiseModel
-from render_cams.scene import pinhole_K
-from render_cams.tracking import UnknownDeviceError
+from avatarsim.render_cams.device import DeviceError
+from avatarsim.render_cams.kinect.noise import AZURE_KINECT_NOISE, KINECT_V2_NOISE, DepthNoiseModel
+from avatarsim.render_cams.scene import pinhole_K
+from avatarsim.render_cams.tracking import UnknownDeviceError
 
 KINECT_RATE_HZ = 30.0
 

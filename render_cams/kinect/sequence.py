@@ -21,10 +21,10 @@ from typing import Any
 import cv2
 import numpy as np
 
-from render_cams.kinect.depth import colourise, write_png
-from render_cams.kinect.device import KinectRecording
-from render_cams.kinect.sensors import DepthSensor, KinectError
-from render_cams.kinect.skeleton import KinectSkeletonStream, TrackingState
+from avatarsim.render_cams.kinect.depth import colourise, write_png
+from avatarsim.render_cams.kinect.device import KinectRecording
+from avatarsim.render_cams.kinect.sensors import DepthSensor, KinectError
+from avatarsim.render_cams.kinect.skeleton import KinectSkeletonStream, TrackingState
 
 _STATE_BGR = {
     TrackingState.TRACKED: (80, 220, 80),

@@ -19,15 +19,15 @@ from typing import Any
 import numpy as np
 from scipy.signal import lfilter
 
-from avatar_models import Motion
-from avatar_models.body import BodyDescription
-from avatar_models.rigs import Rig, load_rig
-from render_cams.device import motion_at_rate, resolve_seed
-from render_cams.kinect.capsules import posed_capsules
-from render_cams.kinect.placement import check_sensor_pose, default_sensor_pose
-from render_cams.kinect.rig_joints import rig_joints
-from render_cams.kinect.sensors import DepthSensor, KinectError, get_sensor
-from render_cams.scene import body_for_motion
+from avatarsim.avatar_models import Motion
+from avatarsim.avatar_models.body import BodyDescription
+from avatarsim.avatar_models.rigs import Rig, load_rig
+from avatarsim.render_cams.device import motion_at_rate, resolve_seed
+from avatarsim.render_cams.kinect.capsules import posed_capsules
+from avatarsim.render_cams.kinect.placement import check_sensor_pose, default_sensor_pose
+from avatarsim.render_cams.kinect.rig_joints import rig_joints
+from avatarsim.render_cams.kinect.sensors import DepthSensor, KinectError, get_sensor
+from avatarsim.render_cams.scene import body_for_motion
 
 
 class TrackingState(IntEnum):

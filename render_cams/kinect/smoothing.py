@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from render_cams.kinect.sensors import KinectError
+from avatarsim.render_cams.kinect.sensors import KinectError
 
 
 @dataclass(frozen=True)

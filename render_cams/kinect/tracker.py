@@ -20,15 +20,15 @@ from typing import Any
 
 import numpy as np
 
-from avatar_models.rigs import load_rig
-from render_cams.kinect.features import BACKGROUND_M, body_depth
-from render_cams.kinect.forest import Forest, load_forest
-from render_cams.kinect.meanshift import densest_mode
-from render_cams.kinect.parts import N_PARTS
-from render_cams.kinect.rig_joints import body17_dependencies, rig_joints_from_body17
-from render_cams.kinect.sensors import DepthSensor, KinectError
-from render_cams.kinect.skeleton import KinectSkeletonStream, TrackingState
-from render_cams.kinect.smoothing import SmoothParameters, smooth_joints
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.render_cams.kinect.features import BACKGROUND_M, body_depth
+from avatarsim.render_cams.kinect.forest import Forest, load_forest
+from avatarsim.render_cams.kinect.meanshift import densest_mode
+from avatarsim.render_cams.kinect.parts import N_PARTS
+from avatarsim.render_cams.kinect.rig_joints import body17_dependencies, rig_joints_from_body17
+from avatarsim.render_cams.kinect.sensors import DepthSensor, KinectError
+from avatarsim.render_cams.kinect.skeleton import KinectSkeletonStream, TrackingState
+from avatarsim.render_cams.kinect.smoothing import SmoothParameters, smooth_joints
 
 MODELS = Path(__file__).with_name("models")
 DEFAULT_MODEL = MODELS / "kinect-tracker.npz"

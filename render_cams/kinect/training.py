@@ -18,18 +18,18 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.config import ConfigError, load_toml, setting
-from avatar_models.generator import ACTIVITIES, generate, sample_subject
-from avatar_models.memory import require_memory
-from avatar_models.rigs import body17_positions
-from render_cams.kinect.depth import KinectDepthCamera
-from render_cams.kinect.features import DepthFeatures, body_depth
-from render_cams.kinect.forest import from_sklearn
-from render_cams.kinect.parts import N_PARTS
-from render_cams.kinect.placement import default_sensor_pose, performer_target
-from render_cams.kinect.sensors import SENSORS, KinectError, get_sensor
-from render_cams.kinect.tracker import BodyPartTracker, load_tracker
-from render_cams.scene import BodyScene
+from avatarsim.avatar_models.config import ConfigError, load_toml, setting
+from avatarsim.avatar_models.generator import ACTIVITIES, generate, sample_subject
+from avatarsim.avatar_models.memory import require_memory
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams.kinect.depth import KinectDepthCamera
+from avatarsim.render_cams.kinect.features import DepthFeatures, body_depth
+from avatarsim.render_cams.kinect.forest import from_sklearn
+from avatarsim.render_cams.kinect.parts import N_PARTS
+from avatarsim.render_cams.kinect.placement import default_sensor_pose, performer_target
+from avatarsim.render_cams.kinect.sensors import SENSORS, KinectError, get_sensor
+from avatarsim.render_cams.kinect.tracker import BodyPartTracker, load_tracker
+from avatarsim.render_cams.scene import BodyScene
 
 
 @dataclass(frozen=True)

@@ -6,10 +6,10 @@ timestamp jitter), :mod:`.dropouts` (tracking loss), :mod:`.faults` (contract-br
 for robustness tests) and :mod:`.setup` (the ``VRSetup`` device that ties them together).
 """
 
-from render_cams.vr.attachments import Attachment, OffsetSpread, attachment_poses
-from render_cams.vr.dropouts import Dropouts, Occlusion
-from render_cams.vr.faults import NaNSamples, OutOfOrder
-from render_cams.vr.noise import (
+from avatarsim.render_cams.vr.attachments import Attachment, OffsetSpread, attachment_poses
+from avatarsim.render_cams.vr.dropouts import Dropouts, Occlusion
+from avatarsim.render_cams.vr.faults import NaNSamples, OutOfOrder
+from avatarsim.render_cams.vr.noise import (
     Drift,
     Latency,
     NoiseModel,
@@ -17,8 +17,12 @@ from render_cams.vr.noise import (
     RotationJitter,
     TimestampJitter,
 )
-from render_cams.vr.placements import FULL_BODY, HEADSET_AND_CONTROLLERS, nominal_attachment
-from render_cams.vr.setup import VRSetup
+from avatarsim.render_cams.vr.placements import (
+    FULL_BODY,
+    HEADSET_AND_CONTROLLERS,
+    nominal_attachment,
+)
+from avatarsim.render_cams.vr.setup import VRSetup
 
 __all__ = [
     "FULL_BODY",

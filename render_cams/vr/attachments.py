@@ -21,10 +21,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from avatar_models import Motion, MotionValueError, quat
-from avatar_models.body17 import BODY17
-from avatar_models.rigs import identify_rig
-from render_cams.device import DeviceError
+from avatarsim.avatar_models import Motion, MotionValueError, quat
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.avatar_models.rigs import identify_rig
+from avatarsim.render_cams.device import DeviceError
 
 
 @dataclass(frozen=True, eq=False)  # array fields: compare with as_dict(), not ==

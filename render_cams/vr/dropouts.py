@@ -11,9 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from render_cams.device import DeviceError
-from render_cams.tracking import TrackingStream
-from render_cams.vr.noise import check_non_negative, target_mask
+from avatarsim.render_cams.device import DeviceError
+from avatarsim.render_cams.tracking import TrackingStream
+from avatarsim.render_cams.vr.noise import check_non_negative, target_mask
 
 
 def invalidate(stream: TrackingStream, lost: np.ndarray) -> TrackingStream:

@@ -12,9 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from render_cams.device import DeviceError
-from render_cams.tracking import TrackingStream
-from render_cams.vr.noise import target_mask
+from avatarsim.render_cams.device import DeviceError
+from avatarsim.render_cams.tracking import TrackingStream
+from avatarsim.render_cams.vr.noise import target_mask
 
 
 def _check_fraction(model: object, *names: str) -> None:

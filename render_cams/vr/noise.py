@@ -26,9 +26,9 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
-from render_cams.device import DeviceError
-from render_cams.tracking import TrackingStream
+from avatarsim.avatar_models import quat
+from avatarsim.render_cams.device import DeviceError
+from avatarsim.render_cams.tracking import TrackingStream
 
 
 @runtime_checkable

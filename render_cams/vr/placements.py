@@ -25,10 +25,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import Skeleton, quat
-from avatar_models.rigs import identify_rig
-from render_cams.tracking import UnknownDeviceError
-from render_cams.vr.attachments import Attachment
+from avatarsim.avatar_models import Skeleton, quat
+from avatarsim.avatar_models.rigs import identify_rig
+from avatarsim.render_cams.tracking import UnknownDeviceError
+from avatarsim.render_cams.vr.attachments import Attachment
 
 HEADSET_AND_CONTROLLERS: tuple[str, ...] = ("hmd", "left_controller", "right_controller")
 FULL_BODY: tuple[str, ...] = (

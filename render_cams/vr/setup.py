@@ -16,12 +16,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from avatar_models import Motion
-from render_cams.device import DeviceError, check_rate, motion_at_rate, resolve_seed
-from render_cams.tracking import TrackingStream, UnknownDeviceError
-from render_cams.vr.attachments import Attachment, OffsetSpread, attachment_poses
-from render_cams.vr.noise import NoiseModel, describe
-from render_cams.vr.placements import FULL_BODY, HEADSET_AND_CONTROLLERS, nominal_attachment
+from avatarsim.avatar_models import Motion
+from avatarsim.render_cams.device import DeviceError, check_rate, motion_at_rate, resolve_seed
+from avatarsim.render_cams.tracking import TrackingStream, UnknownDeviceError
+from avatarsim.render_cams.vr.attachments import Attachment, OffsetSpread, attachment_poses
+from avatarsim.render_cams.vr.noise import NoiseModel, describe
+from avatarsim.render_cams.vr.placements import (
+    FULL_BODY,
+    HEADSET_AND_CONTROLLERS,
+    nominal_attachment,
+)
 
 
 @dataclass(frozen=True)

@@ -65,5 +65,5 @@ def run_benchmark(name: str, quick: bool = False, mocap: Path | None = None) -> 
     read real clips (:func:`avatar_models.mocap_dir.mocap_dir`; None: generated motion)."""
     if name not in BENCHMARKS:
         raise KeyError(name)
-    module = importlib.import_module(f"scripts.benchmarks.{BENCHMARKS[name]}")
+    module = importlib.import_module(f"avatarsim.scripts.benchmarks.{BENCHMARKS[name]}")
     return module.run(quick=quick, mocap=mocap)

@@ -31,18 +31,23 @@ from pathlib import Path
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from avatar_models import quat
-from avatar_models.generator import generate, sample_subject
-from render_cams.vr import FULL_BODY
-from scripts.benchmarks import BenchRow, best_of
-from scripts.stages.devices import REALISTIC_NOISE
-from synthesis.avatargo import AvatarGo
-from synthesis.avatargo.study import sample_user, setup_for
-from synthesis.avatargo.synthesizer import ANALYTIC, ITERATIONS_PER_TICK, QP_SOLVERS, SOLVERS
-from synthesis.avatargo.walk_in import walk_in
-from synthesis.base import FrameBatch, on_clock
-from synthesis.ik_baseline import IKBaseline
-from synthesis.scoring import step_times_ms
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.generator import generate, sample_subject
+from avatarsim.render_cams.vr import FULL_BODY
+from avatarsim.scripts.benchmarks import BenchRow, best_of
+from avatarsim.scripts.stages.devices import REALISTIC_NOISE
+from avatarsim.synthesis.avatargo import AvatarGo
+from avatarsim.synthesis.avatargo.study import sample_user, setup_for
+from avatarsim.synthesis.avatargo.synthesizer import (
+    ANALYTIC,
+    ITERATIONS_PER_TICK,
+    QP_SOLVERS,
+    SOLVERS,
+)
+from avatarsim.synthesis.avatargo.walk_in import walk_in
+from avatarsim.synthesis.base import FrameBatch, on_clock
+from avatarsim.synthesis.ik_baseline import IKBaseline
+from avatarsim.synthesis.scoring import step_times_ms
 
 AIM_MS = 1.0
 FRAME_BUDGET_MS = 1000.0 / 90.0

@@ -12,14 +12,14 @@ from pathlib import Path
 import cv2
 import numpy as np
 
-from avatar_models.generator import generate
-from avatar_models.rigs import body17_positions
-from render_cams.fisheye.keypoints import project_joints, world_to_camera
-from render_cams.fisheye.model import FisheyeModel
-from render_cams.fisheye.render import FisheyeRenderer
-from render_cams.fisheye.rig import camera_poses, controller_cameras
-from render_cams.scene import BodyScene
-from scripts.benchmarks import BenchRow, best_of
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams.fisheye.keypoints import project_joints, world_to_camera
+from avatarsim.render_cams.fisheye.model import FisheyeModel
+from avatarsim.render_cams.fisheye.render import FisheyeRenderer
+from avatarsim.render_cams.fisheye.rig import camera_poses, controller_cameras
+from avatarsim.render_cams.scene import BodyScene
+from avatarsim.scripts.benchmarks import BenchRow, best_of
 
 SENSOR_FPS = 30.0
 

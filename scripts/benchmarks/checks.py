@@ -11,12 +11,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from avatar_models.generator import generate
-from scripts.benchmarks import BenchRow, best_of
-from sim.checks import ALL_CHECKS
-from sim.humanoid import humanoid_for
-from sim.plausibility import check_qpos
-from sim.replay import replay_kinematic
+from avatarsim.avatar_models.generator import generate
+from avatarsim.scripts.benchmarks import BenchRow, best_of
+from avatarsim.sim.checks import ALL_CHECKS
+from avatarsim.sim.humanoid import humanoid_for
+from avatarsim.sim.plausibility import check_qpos
+from avatarsim.sim.replay import replay_kinematic
 
 REAL_TIME_HZ = 90.0
 

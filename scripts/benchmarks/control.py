@@ -17,13 +17,13 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from avatar_models.formats import load_motion
-from avatar_models.generator import generate
-from scripts.benchmarks import BenchRow, best_of
-from sim.control.controller import control
-from sim.control.search import search
-from sim.humanoid import humanoid_for
-from sim.retarget import retarget
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.generator import generate
+from avatarsim.scripts.benchmarks import BenchRow, best_of
+from avatarsim.sim.control.controller import control
+from avatarsim.sim.control.search import search
+from avatarsim.sim.humanoid import humanoid_for
+from avatarsim.sim.retarget import retarget
 
 RETARGET_CLIP = "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh"
 

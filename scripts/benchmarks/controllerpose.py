@@ -22,22 +22,22 @@ import cv2
 import numpy as np
 import torch
 
-from avatar_models.body17_angles import angles_from_positions
-from avatar_models.generator import generate
-from avatar_models.rigs import body17_positions
-from render_cams.fisheye.model import FisheyeModel
-from render_cams.fisheye.rig import CONTROLLERS, controller_cameras
-from render_cams.fisheye.stitch import stitch_params
-from render_cams.fisheye.torso_view import torso_view
-from render_cams.vr import HEADSET_AND_CONTROLLERS, VRSetup
-from scripts.benchmarks import BenchRow, best_of
-from scripts.controllerpose.recording import keypoint_recording
-from sim.humanoid import humanoid_for
-from synthesis.base import FrameBatch, on_clock
-from synthesis.controllerpose.checkpoint import untrained
-from synthesis.controllerpose.examples import VRStream, frame_features
-from synthesis.controllerpose.fk import forward_kinematics
-from synthesis.controllerpose.synthesizer import ControllerPose
+from avatarsim.avatar_models.body17_angles import angles_from_positions
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams.fisheye.model import FisheyeModel
+from avatarsim.render_cams.fisheye.rig import CONTROLLERS, controller_cameras
+from avatarsim.render_cams.fisheye.stitch import stitch_params
+from avatarsim.render_cams.fisheye.torso_view import torso_view
+from avatarsim.render_cams.vr import HEADSET_AND_CONTROLLERS, VRSetup
+from avatarsim.scripts.benchmarks import BenchRow, best_of
+from avatarsim.scripts.controllerpose.recording import keypoint_recording
+from avatarsim.sim.humanoid import humanoid_for
+from avatarsim.synthesis.base import FrameBatch, on_clock
+from avatarsim.synthesis.controllerpose.checkpoint import untrained
+from avatarsim.synthesis.controllerpose.examples import VRStream, frame_features
+from avatarsim.synthesis.controllerpose.fk import forward_kinematics
+from avatarsim.synthesis.controllerpose.synthesizer import ControllerPose
 
 PAPER_MS = {"pose_estimation": 128.0, "compositing": 63.0, "unity_ik": 17.0, "total": 297.0}
 PAPER_FPS = 7.2

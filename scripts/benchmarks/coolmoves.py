@@ -24,13 +24,13 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.generator import generate, sample_subject
-from render_cams import VRSetup
-from scripts.benchmarks import BenchRow, best_of
-from synthesis.coolmoves import build_database
-from synthesis.evaluate import PAPER_ACTIVITIES
-from synthesis.methods import MethodInputs, build
-from synthesis.scoring import step_times_ms
+from avatarsim.avatar_models.generator import generate, sample_subject
+from avatarsim.render_cams import VRSetup
+from avatarsim.scripts.benchmarks import BenchRow, best_of
+from avatarsim.synthesis.coolmoves import build_database
+from avatarsim.synthesis.evaluate import PAPER_ACTIVITIES
+from avatarsim.synthesis.methods import MethodInputs, build
+from avatarsim.synthesis.scoring import step_times_ms
 
 PAPER_BACKEND_MS = 1000.0 / 152.0
 PAPER_GMM_MS = 1000.0 / 44.0

@@ -21,9 +21,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from scripts.benchmarks import BenchRow
-from scripts.dataset.config import DatasetConfig, from_dict
-from scripts.dataset.runner import generate
+from avatarsim.scripts.benchmarks import BenchRow
+from avatarsim.scripts.dataset.config import DatasetConfig, from_dict
+from avatarsim.scripts.dataset.runner import generate
 
 ACTIVITIES = ["walk", "box", "wave", "kick"]  # a planned gait, arms, a balance: mixed costs
 KEYPOINTS = {"name": "kp", "vr_noise": "realistic"}
@@ -60,7 +60,7 @@ def _read_rate(root: Path, workers: int, epochs: int) -> float:
     workers, as a training loop keeps them)."""
     from torch.utils.data import DataLoader
 
-    from scripts.dataset.torch_dataset import ShardDataset
+    from avatarsim.scripts.dataset.torch_dataset import ShardDataset
 
     data = ShardDataset(root, "train", shuffle_buffer=8, seed=0)
     loader = DataLoader(data, batch_size=None, num_workers=workers, persistent_workers=workers > 0)

@@ -11,9 +11,9 @@ from __future__ import annotations
 import tempfile
 from pathlib import Path
 
-from avatar_models.formats.bvh import read_bvh, write_bvh
-from avatar_models.generator import generate
-from scripts.benchmarks import BenchRow, best_of
+from avatarsim.avatar_models.formats.bvh import read_bvh, write_bvh
+from avatarsim.avatar_models.generator import generate
+from avatarsim.scripts.benchmarks import BenchRow, best_of
 
 REAL_CLIPS = ("cmu/125_01.bvh", "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh")
 

@@ -10,12 +10,12 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.generator import generate
-from render_cams.kinect import default_sensor_pose, kinect_skeleton
-from render_cams.kinect.depth import KinectDepthCamera
-from render_cams.kinect.sensors import KINECT_RATE_HZ
-from render_cams.scene import BodyScene
-from scripts.benchmarks import BenchRow, best_of
+from avatarsim.avatar_models.generator import generate
+from avatarsim.render_cams.kinect import default_sensor_pose, kinect_skeleton
+from avatarsim.render_cams.kinect.depth import KinectDepthCamera
+from avatarsim.render_cams.kinect.sensors import KINECT_RATE_HZ
+from avatarsim.render_cams.scene import BodyScene
+from avatarsim.scripts.benchmarks import BenchRow, best_of
 
 _SENSOR_RATE = "sensor's own rate"
 

@@ -12,14 +12,14 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.generator import generate
-from avatar_models.measure import standing_height
-from render_cams.kinect import kinect_skeleton
-from render_cams.vr import VRSetup
-from scripts.benchmarks import BenchRow
-from synthesis.ik_baseline import IKBaseline
-from synthesis.movebox import MoveBox
-from synthesis.scoring import step_latencies_ms
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.render_cams.kinect import kinect_skeleton
+from avatarsim.render_cams.vr import VRSetup
+from avatarsim.scripts.benchmarks import BenchRow
+from avatarsim.synthesis.ik_baseline import IKBaseline
+from avatarsim.synthesis.movebox import MoveBox
+from avatarsim.synthesis.scoring import step_latencies_ms
 
 SENSORS = ("kinect-v2", "azure-kinect")
 

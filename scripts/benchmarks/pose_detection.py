@@ -37,25 +37,25 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models import Motion
-from avatar_models.body17 import BODY17
-from avatar_models.formats import load_motion
-from avatar_models.generator import generate
-from avatar_models.rigs import body17_positions
-from render_cams.device import motion_at_rate
-from render_cams.fisheye.blazepose import BlazePoseDetector
-from render_cams.fisheye.detector import MIN_PERSON_JOINTS, ErrorModelDetector
-from render_cams.fisheye.device import FisheyeRig
-from render_cams.fisheye.pck import keypoint_errors, mirror_tolerant, pck
-from render_cams.fisheye.pixel_views import pixel_views
-from render_cams.fisheye.pose2d import composite_keypoints
-from render_cams.fisheye.pose_detector import PoseDetector, ViewTruth
-from render_cams.fisheye.rig import camera_pairs
-from render_cams.fisheye.stitch import stitch_params
-from render_cams.scene import BodyScene
-from render_cams.third_person import render_third_person
-from scripts.benchmarks import BenchRow
-from sim.humanoid import humanoid_for
+from avatarsim.avatar_models import Motion
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams.device import motion_at_rate
+from avatarsim.render_cams.fisheye.blazepose import BlazePoseDetector
+from avatarsim.render_cams.fisheye.detector import MIN_PERSON_JOINTS, ErrorModelDetector
+from avatarsim.render_cams.fisheye.device import FisheyeRig
+from avatarsim.render_cams.fisheye.pck import keypoint_errors, mirror_tolerant, pck
+from avatarsim.render_cams.fisheye.pixel_views import pixel_views
+from avatarsim.render_cams.fisheye.pose2d import composite_keypoints
+from avatarsim.render_cams.fisheye.pose_detector import PoseDetector, ViewTruth
+from avatarsim.render_cams.fisheye.rig import camera_pairs
+from avatarsim.render_cams.fisheye.stitch import stitch_params
+from avatarsim.render_cams.scene import BodyScene
+from avatarsim.render_cams.third_person import render_third_person
+from avatarsim.scripts.benchmarks import BenchRow
+from avatarsim.sim.humanoid import humanoid_for
 
 CAMERA_FPS = 30.0
 # clip name -> (built-in activity or path under the mocap folder, start s)

@@ -21,19 +21,19 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.generator import generate
-from avatar_models.rigs import body17_positions
-from render_cams.fisheye import bad_frames
-from render_cams.fisheye.detector import ErrorModelDetector
-from render_cams.fisheye.device import FisheyeRig
-from render_cams.fisheye.keypoints import confidence, project_joints
-from render_cams.fisheye.model import FisheyeModel
-from render_cams.fisheye.pose2d import controller_views
-from render_cams.fisheye.render import FisheyeRenderer
-from render_cams.fisheye.rig import camera_poses, controller_cameras
-from render_cams.fisheye.stitch import stitch_params
-from render_cams.scene import BodyScene
-from scripts.benchmarks import BenchRow, best_of, pose_detection
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams.fisheye import bad_frames
+from avatarsim.render_cams.fisheye.detector import ErrorModelDetector
+from avatarsim.render_cams.fisheye.device import FisheyeRig
+from avatarsim.render_cams.fisheye.keypoints import confidence, project_joints
+from avatarsim.render_cams.fisheye.model import FisheyeModel
+from avatarsim.render_cams.fisheye.pose2d import controller_views
+from avatarsim.render_cams.fisheye.render import FisheyeRenderer
+from avatarsim.render_cams.fisheye.rig import camera_poses, controller_cameras
+from avatarsim.render_cams.fisheye.stitch import stitch_params
+from avatarsim.render_cams.scene import BodyScene
+from avatarsim.scripts.benchmarks import BenchRow, best_of, pose_detection
 
 FORMER_HALF_WIDTH_DEG = 65.0  # the composite before the 150 deg one
 SEEDS = range(6)

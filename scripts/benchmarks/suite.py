@@ -13,9 +13,9 @@ import tempfile
 import time
 from pathlib import Path
 
-from scripts.benchmarks import BenchRow
-from scripts.suite.discovery import load_suite
-from scripts.suite.runner import run_suite
+from avatarsim.scripts.benchmarks import BenchRow
+from avatarsim.scripts.suite.discovery import load_suite
+from avatarsim.scripts.suite.runner import run_suite
 
 SMOKE = Path(__file__).resolve().parents[1] / "scenarios" / "smoke"
 QUICK = ("walk_physics.toml", "sunk_feet.toml")

@@ -17,7 +17,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from scripts.cli_common import (
+from avatarsim.scripts.cli_common import (
     MIN_FRAMES,
     JsonOpt,
     SeedOpt,
@@ -34,8 +34,8 @@ def corrupted(humanoid, clean_report, defect: str, seed: int):
     """The humanoid of its motion made wrong by ``defect`` (stances from the clean report)."""
     import numpy as np
 
-    from sim.corrupt import corrupt
-    from sim.humanoid import humanoid_for
+    from avatarsim.sim.corrupt import corrupt
+    from avatarsim.sim.humanoid import humanoid_for
 
     stance = clean_report.per_frame()["contact_left"] > 0
     rng = np.random.default_rng(seed)
@@ -71,16 +71,16 @@ def register(app: typer.Typer) -> None:
         json_out: JsonOpt = None,
     ) -> None:
         """Physics plausibility of a motion on the MuJoCo humanoid. Exit 1 if a check fails."""
-        from avatar_models.errors import AvatarsimError
-        from sim.corrupt import DEFECTS
+        from avatarsim.avatar_models.errors import AvatarsimError
+        from avatarsim.sim.corrupt import DEFECTS
 
         if corrupt is not None and corrupt not in DEFECTS:
             raise AvatarsimError(f"--corrupt {corrupt!r}: defects are {', '.join(DEFECTS)}")
         check_outputs(json_out=json_out, out=out, export=export)
-        from sim.humanoid import humanoid_for
-        from sim.plausibility import check_humanoid
-        from sim.report import summary_rows, write_outputs
-        from sim.thresholds import CheckConfig
+        from avatarsim.sim.humanoid import humanoid_for
+        from avatarsim.sim.plausibility import check_humanoid
+        from avatarsim.sim.report import summary_rows, write_outputs
+        from avatarsim.sim.thresholds import CheckConfig
 
         cfg = CheckConfig.from_toml(config) if config is not None else CheckConfig()
         m = load_motion_arg(motion, unit, seed, min_frames=MIN_FRAMES)

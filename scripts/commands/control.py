@@ -21,7 +21,7 @@ import typer
 from rich.markup import escape
 from rich.table import Table
 
-from scripts.cli_common import (
+from avatarsim.scripts.cli_common import (
     MIN_FRAMES,
     JsonOpt,
     SeedOpt,
@@ -33,7 +33,7 @@ from scripts.cli_common import (
     load_motion_arg,
     user_errors,
 )
-from scripts.scenario import MAX_CONTROL_S
+from avatarsim.scripts.scenario import MAX_CONTROL_S
 
 MAX_SEARCH = 64  # samples or beam: 64 x 64 simulations per window is hours per second
 
@@ -74,7 +74,7 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Drive the humanoid under physics to follow a motion. Exit 1 if it falls or does not
         reach the requested time."""
-        from avatar_models.errors import MotionValueError
+        from avatarsim.avatar_models.errors import MotionValueError
 
         if seconds is not None and not 0 < seconds <= MAX_CONTROL_S:
             raise MotionValueError(
@@ -83,12 +83,12 @@ def register(app: typer.Typer) -> None:
         if not (1 <= samples <= MAX_SEARCH and 1 <= beam <= MAX_SEARCH):
             raise MotionValueError(f"--samples and --beam must be 1-{MAX_SEARCH}")
         check_outputs(json_out=json_out, out=out, out_owner="control", export=export)
-        from scripts.control_run import timed_control
-        from scripts.results import atomic_dir
-        from sim.control.reference import looped
-        from sim.control.report import write_outputs
-        from sim.control.search import SearchSettings
-        from sim.humanoid import humanoid_for
+        from avatarsim.scripts.control_run import timed_control
+        from avatarsim.scripts.results import atomic_dir
+        from avatarsim.sim.control.reference import looped
+        from avatarsim.sim.control.report import write_outputs
+        from avatarsim.sim.control.search import SearchSettings
+        from avatarsim.sim.humanoid import humanoid_for
 
         m = load_motion_arg(motion, unit, seed, duration_s=seconds or 10.0, min_frames=MIN_FRAMES)
         if seconds is None and m.duration_s > MAX_CONTROL_S:

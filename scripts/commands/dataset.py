@@ -25,7 +25,7 @@ from rich.progress import (
 )
 from rich.table import Table
 
-from scripts.cli_common import (
+from avatarsim.scripts.cli_common import (
     JsonOpt,
     SeedOpt,
     check_outputs,
@@ -66,10 +66,10 @@ def register(app: typer.Typer) -> None:
         json_out: JsonOpt = None,
     ) -> None:
         """Generate (or resume) a sharded dataset: shards, then the manifest."""
-        from scripts.dataset.config import load_config
-        from scripts.dataset.executors import check_executor
-        from scripts.dataset.plan import plan_samples
-        from scripts.dataset.runner import generate as run_generate
+        from avatarsim.scripts.dataset.config import load_config
+        from avatarsim.scripts.dataset.executors import check_executor
+        from avatarsim.scripts.dataset.plan import plan_samples
+        from avatarsim.scripts.dataset.runner import generate as run_generate
 
         check_executor(executor, workers, address)
         check_outputs(json_out=json_out, out=out)
@@ -126,7 +126,7 @@ def register(app: typer.Typer) -> None:
     @user_errors
     def info(path: DirArg, seed: SeedOpt = 0, json_out: JsonOpt = None) -> None:
         """Counts per split, frames, shards and the config of a dataset."""
-        from scripts.dataset.manifest import read_manifest
+        from avatarsim.scripts.dataset.manifest import read_manifest
 
         check_outputs(json_out=json_out)
         manifest = read_manifest(path)
@@ -159,9 +159,9 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """A picture sheet of random samples with the ground-truth skeleton drawn on (the
         fisheye camera that sees most of it, else a side view)."""
-        from avatar_models.errors import AvatarsimError
-        from scripts.dataset.config import SPLITS
-        from scripts.dataset.preview import preview_sheet
+        from avatarsim.avatar_models.errors import AvatarsimError
+        from avatarsim.scripts.dataset.config import SPLITS
+        from avatarsim.scripts.dataset.preview import preview_sheet
 
         if samples < 1:
             raise AvatarsimError(f"--samples must be at least 1, got {samples}")
@@ -177,7 +177,7 @@ def register(app: typer.Typer) -> None:
     def verify(path: DirArg, seed: SeedOpt = 0, json_out: JsonOpt = None) -> None:
         """Check shard hashes, counts, that nothing is lost or duplicated, and that no
         held-out subject or clip reaches train. Exit 1 when a check fails."""
-        from scripts.dataset.verify import verify_dataset
+        from avatarsim.scripts.dataset.verify import verify_dataset
 
         check_outputs(json_out=json_out)
         report = verify_dataset(path)

@@ -25,8 +25,8 @@ from rich.markup import escape
 from rich.progress import Progress
 from rich.table import Table
 
-from avatar_models.fileio import write_json
-from scripts.cli_common import (
+from avatarsim.avatar_models.fileio import write_json
+from avatarsim.scripts.cli_common import (
     JsonOpt,
     SeedOpt,
     check_outputs,
@@ -38,7 +38,7 @@ from scripts.cli_common import (
 
 
 def _table(results: dict) -> Table:
-    from synthesis.coolmoves.correlation import CORRELATION_THRESHOLD
+    from avatarsim.synthesis.coolmoves.correlation import CORRELATION_THRESHOLD
 
     turned = f", test turned up to {results['heading_deg']:g} deg" if results["heading_deg"] else ""
     if results["db_headings"] > 1:
@@ -67,7 +67,7 @@ def _table(results: dict) -> Table:
 def _board_tables(board: dict) -> list[Table]:
     """The leaderboard as three narrow tables (accuracy, physics, latency), so that method
     names stay whole in an 80-column terminal."""
-    from scripts.leaderboard import COLUMNS, PHYSICS
+    from avatarsim.scripts.leaderboard import COLUMNS, PHYSICS
 
     latency = ("step_ms_p50", "step_ms_p99")
     groups = {
@@ -91,7 +91,7 @@ def _board_tables(board: dict) -> list[Table]:
 
 def write_leaderboard(board: dict, out: Path, json_out: Path | None) -> None:
     """Print the leaderboard; write its JSON, plot and page into ``out``."""
-    from scripts.leaderboard import render_page, tracked_notes, write_plot
+    from avatarsim.scripts.leaderboard import render_page, tracked_notes, write_plot
 
     for table in _board_tables(board):
         console.print(table)
@@ -151,7 +151,7 @@ def _avatargo_tables(results: dict) -> list[Table]:
 
 def write_avatargo(results: dict, out: Path, json_out: Path | None) -> None:
     """Print AvatarGo's study table; write its JSON and plot into ``out``."""
-    from scripts.avatargo_eval import write_plot
+    from avatarsim.scripts.avatargo_eval import write_plot
 
     console.print(f"IK: {results['solver_label']}")
     for table in _avatargo_tables(results):
@@ -214,8 +214,8 @@ def run_movebox(library, out, wanted, per_source, duration, quick, audio, kinect
     """``eval movebox``: inputs checked first (audio, recorded take), then the evaluation
     (:mod:`scripts.movebox_eval`), the story (:mod:`scripts.movebox_story`) and, with
     ``--kinect``, the recorded take retargeted and saved."""
-    from avatar_models.formats import save_motion
-    from scripts.movebox_eval import (
+    from avatarsim.avatar_models.formats import save_motion
+    from avatarsim.scripts.movebox_eval import (
         ACTIVITIES,
         audio_files,
         builtin_takes,
@@ -223,8 +223,8 @@ def run_movebox(library, out, wanted, per_source, duration, quick, audio, kinect
         recorded_take,
         run_movebox_eval,
     )
-    from scripts.movebox_story import write_story
-    from synthesis.base import SynthesisError
+    from avatarsim.scripts.movebox_story import write_story
+    from avatarsim.synthesis.base import SynthesisError
 
     files = audio_files(audio) if audio is not None else []
     take = recorded_take(kinect) if kinect is not None else None
@@ -295,7 +295,7 @@ OLD_NAMES = {"avatargo": "avatargo-study", "movebox": "movebox-study"}
 def _old_eval(args: list[str], commands) -> tuple[list[str], str] | None:
     """``eval METHOD ...`` -> ``eval protocol METHOD ...``; ``eval avatargo``/``movebox`` ->
     ``eval avatargo-study``/``movebox-study``."""
-    from scripts.cli_legacy import is_new_spelling
+    from avatarsim.scripts.cli_legacy import is_new_spelling
 
     if is_new_spelling(args, commands) or args[0].startswith("-"):
         return None
@@ -307,7 +307,7 @@ def _old_eval(args: list[str], commands) -> tuple[list[str], str] | None:
 
 def _check_ranges(*checks: tuple[str, float, float, float]) -> None:
     """Each ``(option, value, lo, hi)`` within ``[lo, hi]`` (NaN is not)."""
-    from synthesis.evaluate import EvaluationError
+    from avatarsim.synthesis.evaluate import EvaluationError
 
     for option, value, lo, hi in checks:
         if not lo <= value <= hi:  # also NaN
@@ -316,7 +316,7 @@ def _check_ranges(*checks: tuple[str, float, float, float]) -> None:
 
 def _check_source(library: str, max_per_class: int | None, duration: float) -> None:
     """The options every evaluation on motions has: the source, subsampling, take length."""
-    from synthesis.evaluate import EvaluationError
+    from avatarsim.synthesis.evaluate import EvaluationError
 
     _check_ranges(
         ("--duration", duration, 0.5, 600.0),
@@ -327,7 +327,7 @@ def _check_source(library: str, max_per_class: int | None, duration: float) -> N
 
 
 def _check_protocol(protocol: str) -> None:
-    from synthesis.evaluate import PROTOCOLS, EvaluationError
+    from avatarsim.synthesis.evaluate import PROTOCOLS, EvaluationError
 
     if protocol not in PROTOCOLS:
         raise EvaluationError(f"unknown protocol {protocol!r}; use {' or '.join(PROTOCOLS)}")
@@ -349,7 +349,7 @@ def _trials(
     seed: int,
 ) -> tuple[list, float]:
     """The trials to evaluate and the seconds per built-in take (``--quick`` shrinks both)."""
-    from synthesis.evaluate import builtin_trials, library_trials
+    from avatarsim.synthesis.evaluate import builtin_trials, library_trials
 
     _check_ranges(("--subjects", subjects, 1, 50), ("--takes", takes, 1, 20))
     if quick:
@@ -377,7 +377,7 @@ def _progress(bar: Progress, label: str):
 
 def write_protocol(results: dict, out: Path, json_out: Path | None) -> None:
     """Print a protocol's tables and notes; write its JSON and plots into ``out``."""
-    from synthesis.report_plots import write_plots
+    from avatarsim.synthesis.report_plots import write_plots
 
     console.print(_table(results))
     if "ablation_full_cm" in results["overall"]:
@@ -401,7 +401,7 @@ def write_protocol(results: dict, out: Path, json_out: Path | None) -> None:
 
 
 def register(app: typer.Typer) -> None:
-    from scripts.cli_legacy import legacy_group
+    from avatarsim.scripts.cli_legacy import legacy_group
 
     group = typer.Typer(
         cls=legacy_group(_old_eval),
@@ -417,7 +417,7 @@ def register(app: typer.Typer) -> None:
             str,
             typer.Argument(
                 help="coolmoves (the paper's), coolmoves+arm-ik, coolmoves-gmm, "
-                "coolmoves-centroid-align, coolmoves-own-hand-align (synthesis.methods)."
+                "coolmoves-centroid-align, coolmoves-own-hand-align (avatarsim.synthesis.methods)."
             ),
         ],
         library: LibraryOpt = "builtin",
@@ -448,8 +448,8 @@ def register(app: typer.Typer) -> None:
         json_out: JsonOpt = None,
     ) -> None:
         """Accuracy protocols of a synthesis method, IK baseline beside (CoolMoves §4.1)."""
-        from synthesis.coolmoves.correlation import CORRELATION_THRESHOLD
-        from synthesis.evaluate import EVALUABLE, EvaluationError, run_protocol
+        from avatarsim.synthesis.coolmoves.correlation import CORRELATION_THRESHOLD
+        from avatarsim.synthesis.evaluate import EVALUABLE, EvaluationError, run_protocol
 
         if correlation_threshold is None:
             correlation_threshold = CORRELATION_THRESHOLD
@@ -511,9 +511,9 @@ def register(app: typer.Typer) -> None:
 
         scripts/leaderboard.py. Each fold's rows are saved in OUT/folds: a rerun with the same
         settings resumes."""
-        from scripts.leaderboard import run_leaderboard
-        from synthesis.evaluate import EvaluationError
-        from synthesis.methods import METHODS
+        from avatarsim.scripts.leaderboard import run_leaderboard
+        from avatarsim.synthesis.evaluate import EvaluationError
+        from avatarsim.synthesis.methods import METHODS
 
         board_methods = None if methods is None else [m.strip() for m in methods.split(",")]
         if board_methods is not None and (
@@ -585,9 +585,13 @@ def register(app: typer.Typer) -> None:
         A geometric proxy: the paper's result is a questionnaire (Sense of Embodiment). One
         user per test motion (scripts/avatargo_eval.py); writes avatargo.json and
         avatargo.png."""
-        from scripts.avatargo_eval import BUILTIN_ACTIVITIES, QUICK_ACTIVITIES, run_avatargo_eval
-        from synthesis.avatargo.synthesizer import SOLVERS
-        from synthesis.evaluate import EvaluationError
+        from avatarsim.scripts.avatargo_eval import (
+            BUILTIN_ACTIVITIES,
+            QUICK_ACTIVITIES,
+            run_avatargo_eval,
+        )
+        from avatarsim.synthesis.avatargo.synthesizer import SOLVERS
+        from avatarsim.synthesis.evaluate import EvaluationError
 
         if solver not in SOLVERS:
             raise EvaluationError(f"--solver must be one of {', '.join(SOLVERS)}, got {solver!r}")
@@ -674,6 +678,6 @@ def register(app: typer.Typer) -> None:
         """ControllerPose §5.3 accuracy on a dataset's held-out split and on real mocap.
 
         scripts/controllerpose/evaluation.py; writes eval.json and per_joint.png."""
-        from scripts.controllerpose.evaluation import evaluate_command
+        from avatarsim.scripts.controllerpose.evaluation import evaluate_command
 
         evaluate_command(model, data, no_vr_model, frame_stride, out, json_out, mocap, seed)

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 from rich.markup import escape
 
-from scripts.cli_common import (
+from avatarsim.scripts.cli_common import (
     JsonOpt,
     SeedOpt,
     check_outputs,
@@ -32,7 +32,7 @@ from scripts.cli_common import (
 )
 
 if TYPE_CHECKING:  # imported where used (keeps `--help` fast)
-    from sim.humanoid import Humanoid
+    from avatarsim.sim.humanoid import Humanoid
 
 KINECT_DEVICES = ("kinect-v2", "azure-kinect", "azure-kinect-wfov-binned")
 DEFAULT_DURATION_S = 2.0
@@ -42,7 +42,7 @@ SIZE_RANGE = (16, 4096)  # fisheye image side in pixels
 
 def _numbers(text: str | None, option: str, n: int, kind=float) -> tuple | None:
     """``"A,B[,C]"`` -> ``n`` finite numbers of ``kind``; a clear error for anything else."""
-    from avatar_models.errors import AvatarsimError
+    from avatarsim.avatar_models.errors import AvatarsimError
 
     if text is None:
         return None
@@ -58,7 +58,7 @@ def _numbers(text: str | None, option: str, n: int, kind=float) -> tuple | None:
 
 def _rad(degrees: float) -> float:
     """Degrees (CLI) to radians, refusing NaN and infinities."""
-    from avatar_models.errors import AvatarsimError
+    from avatarsim.avatar_models.errors import AvatarsimError
 
     if not math.isfinite(degrees):
         raise AvatarsimError(f"angles must be finite numbers of degrees, got {degrees}")
@@ -73,7 +73,7 @@ def _pair(text: str | None, option: str, default: tuple, kind=float) -> tuple:
 def _parse_range(start_s: float, end: str | None) -> float | str | None:
     """``--end`` as seconds after a valid ``--start``, ``"end"``, or None (checked before any
     motion is loaded)."""
-    from avatar_models.errors import AvatarsimError
+    from avatarsim.avatar_models.errors import AvatarsimError
 
     if not (math.isfinite(start_s) and start_s >= 0):
         raise AvatarsimError(f"--start must be a non-negative number of seconds, got {start_s}")
@@ -92,7 +92,7 @@ def _frame_range(
     start_s: float, end: float | str | None, duration_s: float | None, clip_s: float
 ) -> tuple[float, float]:
     """The ``(start, end)`` seconds to render of a clip of ``clip_s`` seconds."""
-    from avatar_models.errors import AvatarsimError
+    from avatarsim.avatar_models.errors import AvatarsimError
 
     if start_s >= clip_s:
         raise AvatarsimError(f"--start {start_s:g} s is past the clip's end ({clip_s:.3f} s)")
@@ -116,10 +116,10 @@ def _fisheye_rig(
     grip_pitch: float | None,
 ):
     """The ``FisheyeRig`` the fisheye options describe (checked before any motion loads)."""
-    from avatar_models.errors import AvatarsimError
-    from render_cams.fisheye.device import FisheyeRig
-    from render_cams.fisheye.model import FisheyeModel
-    from render_cams.fisheye.rig import Mount
+    from avatarsim.avatar_models.errors import AvatarsimError
+    from avatarsim.render_cams.fisheye.device import FisheyeRig
+    from avatarsim.render_cams.fisheye.model import FisheyeModel
+    from avatarsim.render_cams.fisheye.rig import Mount
 
     fov_deg = _pair(fov, "--fov", (150, 120))
     size_px = _pair(size, "--size", (640, 480), int)
@@ -148,7 +148,7 @@ def _kinect_placement(
     """``(position, camera_to_world, height)`` from the Kinect options: the pose is None for
     the automatic set-up (at ``height``) and for a position aimed at the performer (then
     ``position`` is set; the pose follows from the motion)."""
-    from render_cams.kinect.placement import (
+    from avatarsim.render_cams.kinect.placement import (
         DEFAULT_HEIGHT_M,
         KinectPlacementError,
         look_at,
@@ -199,7 +199,7 @@ def _render(
 ) -> None:
     """Check the frame range and outputs, load the motion, ``record(humanoid, out)`` it and
     report (the device's own options were checked before this)."""
-    from avatar_models.errors import AvatarsimError
+    from avatarsim.avatar_models.errors import AvatarsimError
 
     if duration_s is not None and end is not None:
         raise AvatarsimError("give --end or --duration-s, not both")
@@ -221,7 +221,7 @@ def _render(
 
     # The humanoid for this motion, built once and passed to the device (a foreign rig,
     # e.g. Bandai's, is retargeted onto it).
-    from sim.humanoid import humanoid_for
+    from avatarsim.sim.humanoid import humanoid_for
 
     humanoid = humanoid_for(m)
     t0 = time.perf_counter()
@@ -240,7 +240,7 @@ def _render(
 
 def _old_render(args: list[str], commands) -> tuple[list[str], str] | None:
     """``render MOTION [--device D] ...`` -> ``render D MOTION ...`` (D: fisheye when absent)."""
-    from scripts.cli_legacy import is_new_spelling
+    from avatarsim.scripts.cli_legacy import is_new_spelling
 
     if is_new_spelling(args, commands):
         return None
@@ -306,9 +306,9 @@ def _kinect_command(device: str) -> Callable[..., None]:
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
     ) -> None:
-        from render_cams.kinect.device import Kinect
-        from render_cams.kinect.placement import look_at, performer_target
-        from render_cams.kinect.sequence import write_kinect_recording
+        from avatarsim.render_cams.kinect.device import Kinect
+        from avatarsim.render_cams.kinect.placement import look_at, performer_target
+        from avatarsim.render_cams.kinect.sequence import write_kinect_recording
 
         pos_xyz, pose, height = _kinect_placement(
             sensor_pos, sensor_yaw, sensor_pitch, sensor_look_at, sensor_height
@@ -333,7 +333,7 @@ def _kinect_command(device: str) -> Callable[..., None]:
 
 
 def register(app: typer.Typer) -> None:
-    from scripts.cli_legacy import legacy_group
+    from avatarsim.scripts.cli_legacy import legacy_group
 
     group = typer.Typer(
         cls=legacy_group(_old_render),
@@ -383,7 +383,7 @@ def register(app: typer.Typer) -> None:
         """The four controller cameras on the hands of MOTION.
 
         PNG frames, 16-bit range in mm, keypoints JSON with the camera model per frame, MP4."""
-        from render_cams.fisheye.sequence import write_fisheye_recording
+        from avatarsim.render_cams.fisheye.sequence import write_fisheye_recording
 
         rig = _fisheye_rig(fov, size, ring_offset, grip_offset, ring_pitch, grip_pitch)
 

@@ -10,7 +10,7 @@ from typing import Annotated
 
 import typer
 
-from scripts.cli_common import (
+from avatarsim.scripts.cli_common import (
     JsonOpt,
     SeedOpt,
     check_outputs,
@@ -63,10 +63,10 @@ def register(app: typer.Typer) -> None:
     ) -> None:
         """Train the ControllerPose lifting network (§4.3) on CPU: curves in RUN/loss.png,
         checkpoint in RUN/checkpoint.pt (resumable), summary in RUN/train.json."""
-        from avatar_models.errors import AvatarsimError
-        from scripts.controllerpose.training import check_fits, run_training
-        from synthesis.controllerpose.network import ConfigValueError, NetConfig
-        from synthesis.controllerpose.train import TrainConfig
+        from avatarsim.avatar_models.errors import AvatarsimError
+        from avatarsim.scripts.controllerpose.training import check_fits, run_training
+        from avatarsim.synthesis.controllerpose.network import ConfigValueError, NetConfig
+        from avatarsim.synthesis.controllerpose.train import TrainConfig
 
         for name, value in (("--max-epochs", max_epochs), ("--frame-stride", frame_stride)):
             if value < 1:
@@ -119,7 +119,7 @@ def register(app: typer.Typer) -> None:
 
         from rich.progress import Progress
 
-        from render_cams.kinect.training import (
+        from avatarsim.render_cams.kinect.training import (
             check_model_output,
             load_training_config,
             render_training_frames,

@@ -17,16 +17,16 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.motion import Motion
-from avatar_models.rigs import body17_positions
-from render_cams import TrackingStream
-from scripts.dataset.config import from_dict
-from scripts.dataset.manifest import read_manifest
-from scripts.dataset.motion_source import window_motion
-from scripts.dataset.plan import plan_samples
-from synthesis.controllerpose.examples import Examples
-from synthesis.coolmoves import Database
-from synthesis.methods import METHODS, MethodInputs
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams import TrackingStream
+from avatarsim.scripts.dataset.config import from_dict
+from avatarsim.scripts.dataset.manifest import read_manifest
+from avatarsim.scripts.dataset.motion_source import window_motion
+from avatarsim.scripts.dataset.plan import plan_samples
+from avatarsim.synthesis.controllerpose.examples import Examples
+from avatarsim.synthesis.coolmoves import Database
+from avatarsim.synthesis.methods import METHODS, MethodInputs
 
 METHOD = "coolmoves"
 

@@ -18,11 +18,16 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.rigs import body17_positions
-from render_cams import TrackingStream
-from scripts.dataset.manifest import MANIFEST_FILE, DatasetError, read_manifest
-from scripts.dataset.torch_dataset import ShardDataset
-from synthesis.controllerpose.examples import Examples, VRStream, concat, recording_examples
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams import TrackingStream
+from avatarsim.scripts.dataset.manifest import MANIFEST_FILE, DatasetError, read_manifest
+from avatarsim.scripts.dataset.torch_dataset import ShardDataset
+from avatarsim.synthesis.controllerpose.examples import (
+    Examples,
+    VRStream,
+    concat,
+    recording_examples,
+)
 
 NEEDED = (
     "body17",
@@ -151,12 +156,12 @@ def mocap_examples(
     Raises:
         DatasetError: the folder has no BVH file.
     """
-    from avatar_models.formats import load_motion
-    from avatar_models.measure import standing_height
-    from render_cams.vr import HEADSET_AND_CONTROLLERS, VRSetup
-    from scripts.controllerpose.recording import keypoint_recording
-    from scripts.stages.devices import REALISTIC_NOISE
-    from sim.humanoid import humanoid_for
+    from avatarsim.avatar_models.formats import load_motion
+    from avatarsim.avatar_models.measure import standing_height
+    from avatarsim.render_cams.vr import HEADSET_AND_CONTROLLERS, VRSetup
+    from avatarsim.scripts.controllerpose.recording import keypoint_recording
+    from avatarsim.scripts.stages.devices import REALISTIC_NOISE
+    from avatarsim.sim.humanoid import humanoid_for
 
     files = mocap_files(folder)
     picked = [files[i] for i in np.linspace(0, len(files) - 1, min(clips, len(files))).astype(int)]

@@ -19,22 +19,30 @@ from typing import Any
 
 import numpy as np
 
-from avatar_models.body17 import BODY17
-from avatar_models.fileio import write_json
-from scripts.controllerpose.coolmoves_baseline import coolmoves_positions, training_motions
-from scripts.controllerpose.data import load_examples, mocap_examples, mocap_files, split_streams
-from scripts.controllerpose.figures import plt, save_png
-from synthesis.controllerpose.checkpoint import Checkpoint, load
-from synthesis.controllerpose.evaluate import (
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.avatar_models.fileio import write_json
+from avatarsim.scripts.controllerpose.coolmoves_baseline import (
+    coolmoves_positions,
+    training_motions,
+)
+from avatarsim.scripts.controllerpose.data import (
+    load_examples,
+    mocap_examples,
+    mocap_files,
+    split_streams,
+)
+from avatarsim.scripts.controllerpose.figures import plt, save_png
+from avatarsim.synthesis.controllerpose.checkpoint import Checkpoint, load
+from avatarsim.synthesis.controllerpose.evaluate import (
     joint_errors,
     model_positions,
     nearest_neighbour_positions,
     normalise,
     summary,
 )
-from synthesis.controllerpose.examples import Examples
-from synthesis.coolmoves import build_database
-from synthesis.evaluate import EvaluationError
+from avatarsim.synthesis.controllerpose.examples import Examples
+from avatarsim.synthesis.coolmoves import build_database
+from avatarsim.synthesis.evaluate import EvaluationError
 
 MOCAP_SECONDS = 4.0
 PAPER = {"mean_cm": 6.98, "sd_cm": 4.2, "limbs_mean_cm": 8.59, "no_vr_mean_cm": 8.76}
@@ -154,7 +162,7 @@ def evaluate_command(
     """``avatarsim eval controllerpose``: checks the options, evaluates, prints a table."""
     from rich.table import Table
 
-    from scripts.cli_common import check_outputs, console, emit_json
+    from avatarsim.scripts.cli_common import check_outputs, console, emit_json
 
     if model is None or data is None:
         raise EvaluationError("eval controllerpose needs --model RUN and --data DIR")

@@ -10,7 +10,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from avatar_models.fileio import write_atomic  # noqa: E402
+from avatarsim.avatar_models.fileio import write_atomic  # noqa: E402
 
 
 def save_png(fig: plt.Figure, path: Path) -> None:

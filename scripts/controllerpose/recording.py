@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from scripts.dataset.channels import fisheye_channel
-from sim.humanoid import Humanoid
-from synthesis.controllerpose.synthesizer import KeypointRecording
+from avatarsim.scripts.dataset.channels import fisheye_channel
+from avatarsim.sim.humanoid import Humanoid
+from avatarsim.synthesis.controllerpose.synthesizer import KeypointRecording
 
 
 def keypoint_recording(humanoid: Humanoid, seed: int) -> KeypointRecording:

@@ -15,13 +15,13 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from avatar_models.errors import AvatarsimError
-from avatar_models.fileio import write_json
-from scripts.controllerpose.data import load_examples, manifest_sha256
-from scripts.controllerpose.figures import plt, save_png
-from synthesis.controllerpose.checkpoint import FILE, CheckpointError, load
-from synthesis.controllerpose.network import NetConfig
-from synthesis.controllerpose.train import TrainConfig, train
+from avatarsim.avatar_models.errors import AvatarsimError
+from avatarsim.avatar_models.fileio import write_json
+from avatarsim.scripts.controllerpose.data import load_examples, manifest_sha256
+from avatarsim.scripts.controllerpose.figures import plt, save_png
+from avatarsim.synthesis.controllerpose.checkpoint import FILE, CheckpointError, load
+from avatarsim.synthesis.controllerpose.network import NetConfig
+from avatarsim.synthesis.controllerpose.train import TrainConfig, train
 
 # What may change between a run and its resumption: how long it goes on.
 STOPPING = ("max_epochs", "time_budget_s", "patience")

@@ -16,11 +16,11 @@ Two terms (bytes), each scaling with a size of the config:
 
 from __future__ import annotations
 
-from avatar_models.memory import FRAME_BYTES, format_bytes, require_memory
-from render_cams.fisheye.device import CAMERA_RATE_HZ
-from render_cams.fisheye.model import PAPER_SIZE
-from render_cams.fisheye.rig import controller_cameras
-from render_cams.kinect.sensors import get_sensor
+from avatarsim.avatar_models.memory import FRAME_BYTES, format_bytes, require_memory
+from avatarsim.render_cams.fisheye.device import CAMERA_RATE_HZ
+from avatarsim.render_cams.fisheye.model import PAPER_SIZE
+from avatarsim.render_cams.fisheye.rig import controller_cameras
+from avatarsim.render_cams.kinect.sensors import get_sensor
 
 PLAN_BYTES_PER_SAMPLE = 1024
 FISHEYE_PIXEL_BYTES = 5

@@ -31,19 +31,19 @@ from typing import Any
 import cv2
 import numpy as np
 
-from avatar_models.rigs import body17_positions
-from render_cams.device import motion_at_rate
-from render_cams.fisheye.detector import ErrorModelDetector
-from render_cams.fisheye.device import CAMERA_RATE_HZ, FisheyeRig
-from render_cams.fisheye.keypoints import confidence, project_joints, world_to_camera
-from render_cams.fisheye.pose2d import controller_views
-from render_cams.fisheye.rig import camera_poses, controller_cameras, inside_body
-from render_cams.kinect import Kinect
-from render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
-from scripts.dataset.config import DeviceSetConfig
-from scripts.stages.devices import REALISTIC_NOISE
-from sim.humanoid import Humanoid
-from sim.plausibility import check_humanoid
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams.device import motion_at_rate
+from avatarsim.render_cams.fisheye.detector import ErrorModelDetector
+from avatarsim.render_cams.fisheye.device import CAMERA_RATE_HZ, FisheyeRig
+from avatarsim.render_cams.fisheye.keypoints import confidence, project_joints, world_to_camera
+from avatarsim.render_cams.fisheye.pose2d import controller_views
+from avatarsim.render_cams.fisheye.rig import camera_poses, controller_cameras, inside_body
+from avatarsim.render_cams.kinect import Kinect
+from avatarsim.render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
+from avatarsim.scripts.dataset.config import DeviceSetConfig
+from avatarsim.scripts.stages.devices import REALISTIC_NOISE
+from avatarsim.sim.humanoid import Humanoid
+from avatarsim.sim.plausibility import check_humanoid
 
 Channel = tuple[dict[str, np.ndarray | bytes], dict[str, Any]]  # bytes: an encoded image
 CM = 0.01  # the checks report centimetres; datasets store metres
@@ -216,4 +216,4 @@ def physics_channel(humanoid: Humanoid) -> Channel:
             np.stack([columns["skate_left_cm_s"], columns["skate_right_cm_s"]], 1) * CM
         ),
     }
-    return arrays, {"source": "sim.plausibility.check_humanoid", "units": "m, m/s"}
+    return arrays, {"source": "avatarsim.sim.plausibility.check_humanoid", "units": "m, m/s"}

@@ -17,11 +17,11 @@ from dataclasses import MISSING, asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any, Literal
 
-from avatar_models.config import ConfigError, from_data, read_toml, setting
-from avatar_models.generator import ACTIVITIES
-from avatar_models.motion import FPS_RANGE
-from render_cams.fisheye.device import SCALE_RANGE
-from scripts.dataset.budget import check_budget
+from avatarsim.avatar_models.config import ConfigError, from_data, read_toml, setting
+from avatarsim.avatar_models.generator import ACTIVITIES
+from avatarsim.avatar_models.motion import FPS_RANGE
+from avatarsim.render_cams.fisheye.device import SCALE_RANGE
+from avatarsim.scripts.dataset.budget import check_budget
 
 SPLITS = ("train", "val", "test")
 SPLIT_TOLERANCE = 1e-6

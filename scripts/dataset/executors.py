@@ -24,7 +24,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from multiprocessing import active_children, get_context
 from typing import Any
 
-from avatar_models.errors import AvatarsimError
+from avatarsim.avatar_models.errors import AvatarsimError
 
 EXECUTORS = ("local", "ray")
 PARENT_POLL_S = 0.5

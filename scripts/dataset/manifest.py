@@ -20,9 +20,9 @@ import json
 from pathlib import Path
 from typing import Any
 
-from avatar_models.fileio import sha256_file, write_json
-from scripts.dataset.config import SPLITS, DatasetConfig, config_hash
-from scripts.dataset.schema import SCHEMA_VERSION, DatasetError, check_manifest
+from avatarsim.avatar_models.fileio import sha256_file, write_json
+from avatarsim.scripts.dataset.config import SPLITS, DatasetConfig, config_hash
+from avatarsim.scripts.dataset.schema import SCHEMA_VERSION, DatasetError, check_manifest
 
 STATE_FILE = "dataset.json"
 MANIFEST_FILE = "manifest.json"

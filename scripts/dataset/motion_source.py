@@ -13,11 +13,11 @@ from functools import lru_cache
 
 import numpy as np
 
-from avatar_models.formats import load_motion
-from avatar_models.generator import generate, sample_subject
-from avatar_models.motion import Motion
-from scripts.dataset.config import DatasetConfig
-from scripts.dataset.plan import MotionWindow, subject_seed
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.generator import generate, sample_subject
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.scripts.dataset.config import DatasetConfig
+from avatarsim.scripts.dataset.plan import MotionWindow, subject_seed
 
 
 def window_frames(config: DatasetConfig) -> int:

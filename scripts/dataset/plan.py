@@ -20,9 +20,9 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.errors import AvatarsimError
-from avatar_models.library import MotionLibrary
-from scripts.dataset.config import SPLITS, ConfigError, DatasetConfig, SourceConfig
+from avatarsim.avatar_models.errors import AvatarsimError
+from avatarsim.avatar_models.library import MotionLibrary
+from avatarsim.scripts.dataset.config import SPLITS, ConfigError, DatasetConfig, SourceConfig
 
 WINDOW_SEEDS, DEVICE_SEEDS, SUBJECT_SEEDS, SPLIT_SEEDS = range(4)
 

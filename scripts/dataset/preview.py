@@ -17,11 +17,11 @@ from typing import Any
 
 import numpy as np
 
-from avatar_models.body17 import INDEX
-from scripts.dataset.channels import IMAGE_SUFFIX
-from scripts.dataset.manifest import DatasetError, read_manifest
-from scripts.dataset.schema import checked_samples
-from scripts.output_file import write_output
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.scripts.dataset.channels import IMAGE_SUFFIX
+from avatarsim.scripts.dataset.manifest import DatasetError, read_manifest
+from avatarsim.scripts.dataset.schema import checked_samples
+from avatarsim.scripts.output_file import write_output
 
 # body17 drawn as lines, coloured by side: trunk, then each arm and leg outwards.
 TRUNK_LINES = (("head", "neck"), ("neck", "pelvis"))

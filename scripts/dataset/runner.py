@@ -22,10 +22,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from avatar_models.fileio import write_atomic, write_json
-from scripts.dataset.config import DatasetConfig, config_hash
-from scripts.dataset.executors import check_executor, run
-from scripts.dataset.manifest import (
+from avatarsim.avatar_models.fileio import write_atomic, write_json
+from avatarsim.scripts.dataset.config import DatasetConfig, config_hash
+from avatarsim.scripts.dataset.executors import check_executor, run
+from avatarsim.scripts.dataset.manifest import (
     SHARD_DIR,
     STATE_FILE,
     DatasetError,
@@ -37,9 +37,9 @@ from scripts.dataset.manifest import (
     write_manifest,
     write_sidecar,
 )
-from scripts.dataset.plan import ShardSpec, plan_samples, plan_shards
-from scripts.dataset.sample import make_sample
-from scripts.dataset.shards import shard_bytes
+from avatarsim.scripts.dataset.plan import ShardSpec, plan_samples, plan_shards
+from avatarsim.scripts.dataset.sample import make_sample
+from avatarsim.scripts.dataset.shards import shard_bytes
 
 
 @dataclass(frozen=True)

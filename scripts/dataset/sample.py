@@ -24,9 +24,9 @@ from typing import Any
 
 import numpy as np
 
-from avatar_models.body17_angles import angles_from_positions
-from avatar_models.rigs import body17_positions
-from scripts.dataset.channels import (
+from avatarsim.avatar_models.body17_angles import angles_from_positions
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.scripts.dataset.channels import (
     f32,
     fisheye_channel,
     fisheye_image_channel,
@@ -34,10 +34,10 @@ from scripts.dataset.channels import (
     physics_channel,
     vr_channel,
 )
-from scripts.dataset.config import DatasetConfig
-from scripts.dataset.motion_source import window_motion
-from scripts.dataset.plan import SampleSpec, subject_seed
-from sim.humanoid import humanoid_for
+from avatarsim.scripts.dataset.config import DatasetConfig
+from avatarsim.scripts.dataset.motion_source import window_motion
+from avatarsim.scripts.dataset.plan import SampleSpec, subject_seed
+from avatarsim.sim.humanoid import humanoid_for
 
 SAMPLE_SCHEMA = 1
 

@@ -32,11 +32,11 @@ from typing import Any
 
 import numpy as np
 
-from avatar_models.body17 import BODY17
-from avatar_models.body17_angles import N_DOF
-from avatar_models.errors import AvatarsimError
-from scripts.dataset.config import SPLITS
-from scripts.dataset.shards import read_samples
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.avatar_models.body17_angles import N_DOF
+from avatarsim.avatar_models.errors import AvatarsimError
+from avatarsim.scripts.dataset.config import SPLITS
+from avatarsim.scripts.dataset.shards import read_samples
 
 SCHEMA_VERSION = 1
 """The manifest's ``schema_version`` this avatarsim writes and reads."""

@@ -25,8 +25,8 @@ from typing import Any
 import cv2
 import numpy as np
 
-from avatar_models.errors import AvatarsimError
-from avatar_models.fileio import json_safe
+from avatarsim.avatar_models.errors import AvatarsimError
+from avatarsim.avatar_models.fileio import json_safe
 
 
 class ShardError(AvatarsimError):

@@ -23,9 +23,9 @@ import numpy as np
 import torch
 from torch.utils.data import IterableDataset, get_worker_info
 
-from scripts.dataset.config import SPLITS
-from scripts.dataset.manifest import DatasetError, read_manifest
-from scripts.dataset.schema import checked_samples
+from avatarsim.scripts.dataset.config import SPLITS
+from avatarsim.scripts.dataset.manifest import DatasetError, read_manifest
+from avatarsim.scripts.dataset.schema import checked_samples
 
 
 class ShardDataset(IterableDataset):

@@ -12,12 +12,12 @@ from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from avatar_models.fileio import sha256_file
-from scripts.dataset.config import SPLITS, ConfigError, config_hash, from_dict
-from scripts.dataset.manifest import STATE_FILE, read_json, read_manifest
-from scripts.dataset.plan import plan_samples
-from scripts.dataset.schema import DatasetError, checked_samples
-from scripts.dataset.shards import ShardError
+from avatarsim.avatar_models.fileio import sha256_file
+from avatarsim.scripts.dataset.config import SPLITS, ConfigError, config_hash, from_dict
+from avatarsim.scripts.dataset.manifest import STATE_FILE, read_json, read_manifest
+from avatarsim.scripts.dataset.plan import plan_samples
+from avatarsim.scripts.dataset.schema import DatasetError, checked_samples
+from avatarsim.scripts.dataset.shards import ShardError
 
 MAX_LISTED = 20  # problems listed one by one; more are counted
 

@@ -1,7 +1,7 @@
 """Scenario stages. Each module has ``METRICS`` (name -> meaning) and ``run(ctx)``; the order
 of :data:`STAGES` is the data flow of ARCHITECTURE.md."""
 
-from scripts.stages import (
+from avatarsim.scripts.stages import (
     body,
     cameras,
     control,

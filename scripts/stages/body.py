@@ -6,11 +6,11 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from avatar_models.fileio import write_atomic
-from avatar_models.formats import save_motion
-from scripts.run_context import RunContext
-from sim.humanoid import humanoid_for
-from sim.replay import replay_kinematic
+from avatarsim.avatar_models.fileio import write_atomic
+from avatarsim.avatar_models.formats import save_motion
+from avatarsim.scripts.run_context import RunContext
+from avatarsim.sim.humanoid import humanoid_for
+from avatarsim.sim.replay import replay_kinematic
 
 METRICS = {
     "replay_error_mm_max": "max distance between MuJoCo's replayed joints and the motion's FK",

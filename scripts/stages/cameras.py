@@ -9,10 +9,10 @@ import cv2
 import imageio.v3 as iio
 import numpy as np
 
-from avatar_models.fileio import write_atomic
-from render_cams.kinect.depth import colourise, read_depth_png
-from scripts.run_context import RunContext
-from scripts.scenario import Scenario
+from avatarsim.avatar_models.fileio import write_atomic
+from avatarsim.render_cams.kinect.depth import colourise, read_depth_png
+from avatarsim.scripts.run_context import RunContext
+from avatarsim.scripts.scenario import Scenario
 
 METRICS = {
     "fisheye_fps_rendered": "fisheye camera frames rendered per second (all cameras)",
@@ -58,8 +58,8 @@ def run(ctx: RunContext) -> None:
     clip, body = window(ctx)
     panels = []
     if spec.fisheye:
-        from render_cams.fisheye.device import FisheyeRig
-        from render_cams.fisheye.sequence import write_fisheye_recording
+        from avatarsim.render_cams.fisheye.device import FisheyeRig
+        from avatarsim.render_cams.fisheye.sequence import write_fisheye_recording
 
         folder = ctx.out_dir / "cameras" / "fisheye"
         recording = FisheyeRig().sample(clip, ctx.scenario.seed, body)
@@ -71,8 +71,8 @@ def run(ctx: RunContext) -> None:
             panels.append(panel(iio.imread(folder / stitched / "000000.png"), stitched))
         ctx.output("fisheye_keypoints", folder / "keypoints.json")
     if spec.kinect:
-        from render_cams.kinect.device import Kinect
-        from render_cams.kinect.sequence import write_kinect_recording
+        from avatarsim.render_cams.kinect.device import Kinect
+        from avatarsim.render_cams.kinect.sequence import write_kinect_recording
 
         folder = ctx.out_dir / "cameras" / spec.kinect
         t0 = time.perf_counter()

@@ -5,12 +5,12 @@ shorter). Writes ``control/`` (CSV, JSON, plot)."""
 
 from __future__ import annotations
 
-from scripts.control_run import timed_control
-from scripts.run_context import RunContext
-from scripts.scenario import Scenario
-from sim.control.reference import looped
-from sim.control.report import write_outputs
-from sim.control.search import SearchSettings
+from avatarsim.scripts.control_run import timed_control
+from avatarsim.scripts.run_context import RunContext
+from avatarsim.scripts.scenario import Scenario
+from avatarsim.sim.control.reference import looped
+from avatarsim.sim.control.report import write_outputs
+from avatarsim.sim.control.search import SearchSettings
 
 METRICS = {
     "control_fell": "1 if the humanoid fell or the search gave up before the end, else 0",

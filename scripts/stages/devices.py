@@ -5,13 +5,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from render_cams.kinect import TrackingState, kinect_skeleton
-from render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
-from render_cams.vr.dropouts import Dropouts
-from render_cams.vr.noise import Drift, Latency, PositionJitter, RotationJitter
-from scripts.run_context import RunContext
-from scripts.scenario import Scenario
-from synthesis.avatargo.walk_in import walk_in
+from avatarsim.render_cams.kinect import TrackingState, kinect_skeleton
+from avatarsim.render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
+from avatarsim.render_cams.vr.dropouts import Dropouts
+from avatarsim.render_cams.vr.noise import Drift, Latency, PositionJitter, RotationJitter
+from avatarsim.scripts.run_context import RunContext
+from avatarsim.scripts.scenario import Scenario
+from avatarsim.synthesis.avatargo.walk_in import walk_in
 
 METRICS = {
     "vr_valid_frac": "share of valid VR samples over all devices",
@@ -81,7 +81,7 @@ def run(ctx: RunContext) -> None:
     )
     ctx.output("vr_stream", stream.to_npz(ctx.out_dir / "vr_stream.npz"))
     if ctx.scenario.devices.fisheye:
-        from scripts.controllerpose.recording import keypoint_recording
+        from avatarsim.scripts.controllerpose.recording import keypoint_recording
 
         ctx.fisheye_keypoints = keypoint_recording(ctx.humanoid, ctx.scenario.seed)
         ctx.info["devices"]["fisheye_frames"] = int(ctx.fisheye_keypoints.time.size)

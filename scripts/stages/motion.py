@@ -6,13 +6,13 @@ import dataclasses
 
 import numpy as np
 
-from avatar_models.errors import MotionValueError
-from avatar_models.formats import load_motion, save_motion
-from avatar_models.generator import ACTIVITIES, generate, sample_subject
-from avatar_models.measure import check_plausible_height
-from scripts.corruption import corrupted
-from scripts.run_context import RunContext
-from scripts.scenario import MIN_FRAMES, ScenarioError
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.formats import load_motion, save_motion
+from avatarsim.avatar_models.generator import ACTIVITIES, generate, sample_subject
+from avatarsim.avatar_models.measure import check_plausible_height
+from avatarsim.scripts.corruption import corrupted
+from avatarsim.scripts.run_context import RunContext
+from avatarsim.scripts.scenario import MIN_FRAMES, ScenarioError
 
 METRICS = {"frames": "number of motion frames"}
 

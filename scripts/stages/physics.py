@@ -6,12 +6,12 @@ scenario's ``[physics]`` table; each thresholded value becomes a check row of th
 
 from __future__ import annotations
 
-from scripts.results import ThresholdResult
-from scripts.run_context import RunContext
-from scripts.scenario import Threshold
-from sim.plausibility import CONTRACT_KEYS, check_humanoid
-from sim.report import write_outputs
-from sim.thresholds import THRESHOLD_KEYS, CheckConfig
+from avatarsim.scripts.results import ThresholdResult
+from avatarsim.scripts.run_context import RunContext
+from avatarsim.scripts.scenario import Threshold
+from avatarsim.sim.plausibility import CONTRACT_KEYS, check_humanoid
+from avatarsim.sim.report import write_outputs
+from avatarsim.sim.thresholds import THRESHOLD_KEYS, CheckConfig
 
 METRICS = {
     key: f"physics check value ({check}); threshold in [physics]"

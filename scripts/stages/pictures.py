@@ -7,10 +7,10 @@ import cv2
 import imageio.v3 as iio
 import numpy as np
 
-from avatar_models.fileio import write_atomic
-from scripts.run_context import RunContext
-from sim.humanoid import Humanoid
-from sim.render import render_frames
+from avatarsim.avatar_models.fileio import write_atomic
+from avatarsim.scripts.run_context import RunContext
+from avatarsim.sim.humanoid import Humanoid
+from avatarsim.sim.render import render_frames
 
 METRICS: dict[str, str] = {}
 

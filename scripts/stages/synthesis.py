@@ -5,20 +5,20 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.generator import generate_library
-from avatar_models.measure import standing_height
-from avatar_models.motion import Motion
-from render_cams.vr import HEADSET_AND_CONTROLLERS, Attachment
-from scripts.method_score import score_method
-from scripts.run_context import RunContext
-from scripts.scenario import Scenario, ScenarioError
-from scripts.stages.physics import config as physics_config
-from sim.humanoid import Humanoid
-from synthesis.base import Synthesizer
-from synthesis.coolmoves import build_database
-from synthesis.ik_baseline import attachments_on_upright_rig
-from synthesis.methods import METHODS, MethodInputs, build
-from synthesis.scoring import GROUPS
+from avatarsim.avatar_models.generator import generate_library
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.render_cams.vr import HEADSET_AND_CONTROLLERS, Attachment
+from avatarsim.scripts.method_score import score_method
+from avatarsim.scripts.run_context import RunContext
+from avatarsim.scripts.scenario import Scenario, ScenarioError
+from avatarsim.scripts.stages.physics import config as physics_config
+from avatarsim.sim.humanoid import Humanoid
+from avatarsim.synthesis.base import Synthesizer
+from avatarsim.synthesis.coolmoves import build_database
+from avatarsim.synthesis.ik_baseline import attachments_on_upright_rig
+from avatarsim.synthesis.methods import METHODS, MethodInputs, build
+from avatarsim.synthesis.scoring import GROUPS
 
 METRICS = {
     **{

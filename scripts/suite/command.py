@@ -16,21 +16,21 @@ from rich.console import Console
 from rich.markup import escape
 from rich.table import Table
 
-from avatar_models.errors import AvatarsimError
-from avatar_models.fileio import write_atomic, write_json
-from scripts.results import atomic_dir, versions
-from scripts.suite.discovery import SuiteEntry, load_suite
-from scripts.suite.identity import scenario_hash
-from scripts.suite.index_html import render_index
-from scripts.suite.junit import suite_junit
-from scripts.suite.regression import (
+from avatarsim.avatar_models.errors import AvatarsimError
+from avatarsim.avatar_models.fileio import write_atomic, write_json
+from avatarsim.scripts.results import atomic_dir, versions
+from avatarsim.scripts.suite.discovery import SuiteEntry, load_suite
+from avatarsim.scripts.suite.identity import scenario_hash
+from avatarsim.scripts.suite.index_html import render_index
+from avatarsim.scripts.suite.junit import suite_junit
+from avatarsim.scripts.suite.regression import (
     BaselineEntry,
     baseline_file,
     check_baseline,
     compare,
     load_baseline,
 )
-from scripts.suite.runner import STATUSES, Outcome, run_suite
+from avatarsim.scripts.suite.runner import STATUSES, Outcome, run_suite
 
 MAX_WORKERS = 256
 COLOURS = {"passed": "green", "failed": "red", "error": "red", "skipped": "dim"}

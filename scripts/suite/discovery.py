@@ -11,8 +11,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
-from scripts.pipeline import validate
-from scripts.scenario import Scenario, ScenarioError, load_scenario
+from avatarsim.scripts.pipeline import validate
+from avatarsim.scripts.scenario import Scenario, ScenarioError, load_scenario
 
 # A scenario's name is its output folder's name; the suite's own files sit beside them.
 NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]*")

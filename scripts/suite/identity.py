@@ -14,7 +14,7 @@ import json
 import os
 from pathlib import Path
 
-from scripts.scenario import Scenario
+from avatarsim.scripts.scenario import Scenario
 
 JUDGING_ONLY = ("name", "seed", "path", "thresholds", "expect_fail", "regression", "report")
 

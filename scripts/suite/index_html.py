@@ -6,7 +6,7 @@ from __future__ import annotations
 import html
 from typing import Any
 
-from scripts.suite.junit import check_message, regression_message
+from avatarsim.scripts.suite.junit import check_message, regression_message
 
 STYLE = """
 body { font-family: system-ui, sans-serif; margin: 2em; color: #222; }

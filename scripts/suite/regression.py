@@ -17,8 +17,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from scripts.scenario import Scenario, ScenarioError
-from scripts.suite.identity import scenario_hash
+from avatarsim.scripts.scenario import Scenario, ScenarioError
+from avatarsim.scripts.suite.identity import scenario_hash
 
 
 @dataclass(frozen=True)

@@ -19,9 +19,9 @@ from typing import Any
 
 from rich.console import Console
 
-from avatar_models.errors import AvatarsimError
-from scripts.pipeline import run_scenario
-from scripts.suite.discovery import SuiteEntry
+from avatarsim.avatar_models.errors import AvatarsimError
+from avatarsim.scripts.pipeline import run_scenario
+from avatarsim.scripts.suite.discovery import SuiteEntry
 
 STATUSES = ("passed", "failed", "skipped", "error")
 

@@ -4,17 +4,17 @@
 line here (and its definition and threshold in :mod:`sim.thresholds`).
 """
 
-from sim.checks.base import Check, CheckResult
-from sim.checks.contact import FootContactCheck
-from sim.checks.floating import FloatingCheck
-from sim.checks.jitter import JitterCheck
-from sim.checks.joint_limits import JointLimitCheck
-from sim.checks.penetration import PenetrationCheck
-from sim.checks.replay import BodyReplay
-from sim.checks.residual import ResidualForceCheck
-from sim.checks.self_collision import SelfCollisionCheck
-from sim.checks.skating import SkatingCheck
-from sim.checks.support import BalanceCheck
+from avatarsim.sim.checks.base import Check, CheckResult
+from avatarsim.sim.checks.contact import FootContactCheck
+from avatarsim.sim.checks.floating import FloatingCheck
+from avatarsim.sim.checks.jitter import JitterCheck
+from avatarsim.sim.checks.joint_limits import JointLimitCheck
+from avatarsim.sim.checks.penetration import PenetrationCheck
+from avatarsim.sim.checks.replay import BodyReplay
+from avatarsim.sim.checks.residual import ResidualForceCheck
+from avatarsim.sim.checks.self_collision import SelfCollisionCheck
+from avatarsim.sim.checks.skating import SkatingCheck
+from avatarsim.sim.checks.support import BalanceCheck
 
 ALL_CHECKS: tuple[Check, ...] = (
     FootContactCheck(),

@@ -13,10 +13,10 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
-from sim.thresholds import CheckConfig
+from avatarsim.sim.thresholds import CheckConfig
 
 if TYPE_CHECKING:
-    from sim.checks.replay import BodyReplay
+    from avatarsim.sim.checks.replay import BodyReplay
 
 
 @dataclass(frozen=True)

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.checks.base import CheckResult
-from sim.checks.replay import BodyReplay
-from sim.thresholds import CheckConfig
+from avatarsim.sim.checks.base import CheckResult
+from avatarsim.sim.checks.replay import BodyReplay
+from avatarsim.sim.thresholds import CheckConfig
 
 
 class JitterCheck:

@@ -26,10 +26,10 @@ import mujoco
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from avatar_models.body.mjcf import chain_name, hinge_name
-from sim.checks.base import CheckResult
-from sim.checks.replay import BodyReplay
-from sim.thresholds import CheckConfig
+from avatarsim.avatar_models.body.mjcf import chain_name, hinge_name
+from avatarsim.sim.checks.base import CheckResult
+from avatarsim.sim.checks.replay import BodyReplay
+from avatarsim.sim.thresholds import CheckConfig
 
 
 def chain_angles(

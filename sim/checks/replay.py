@@ -15,10 +15,10 @@ from functools import cached_property
 import mujoco
 import numpy as np
 
-from avatar_models.body import BodyDescription, Segment
-from avatar_models.foot_contact import contact_mask, lasting
-from sim.replay import ReplayTrace, replay_kinematic
-from sim.thresholds import CheckConfig
+from avatarsim.avatar_models.body import BodyDescription, Segment
+from avatarsim.avatar_models.foot_contact import contact_mask, lasting
+from avatarsim.sim.replay import ReplayTrace, replay_kinematic
+from avatarsim.sim.thresholds import CheckConfig
 
 SIDES = ("left", "right")
 

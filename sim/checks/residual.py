@@ -18,9 +18,9 @@ import mujoco
 import numpy as np
 from scipy.signal import butter, sosfiltfilt
 
-from sim.checks.base import CheckResult
-from sim.checks.replay import BodyReplay
-from sim.thresholds import CheckConfig
+from avatarsim.sim.checks.base import CheckResult
+from avatarsim.sim.checks.replay import BodyReplay
+from avatarsim.sim.thresholds import CheckConfig
 
 
 def lowpass(x: np.ndarray, fps: float, cutoff_hz: float) -> np.ndarray:

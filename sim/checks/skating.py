@@ -19,9 +19,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.checks.base import CheckResult
-from sim.checks.replay import SIDES, BodyReplay
-from sim.thresholds import CheckConfig
+from avatarsim.sim.checks.base import CheckResult
+from avatarsim.sim.checks.replay import SIDES, BodyReplay
+from avatarsim.sim.thresholds import CheckConfig
 
 
 def contact_runs(contact: np.ndarray) -> np.ndarray:

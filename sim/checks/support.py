@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.checks.base import CheckResult
-from sim.checks.replay import BodyReplay
-from sim.thresholds import CheckConfig
+from avatarsim.sim.checks.base import CheckResult
+from avatarsim.sim.checks.replay import BodyReplay
+from avatarsim.sim.thresholds import CheckConfig
 
 CHUNK = 512  # frames per vectorised batch: (CHUNK, K, K, K) floats stay a few MB
 

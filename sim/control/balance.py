@@ -23,9 +23,9 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from avatar_models import quat
-from sim.control.model import BodyIndices
-from sim.control.settings import GRAVITY, ControlSettings
+from avatarsim.avatar_models import quat
+from avatarsim.sim.control.model import BodyIndices
+from avatarsim.sim.control.settings import GRAVITY, ControlSettings
 
 
 def reference_stance(ankle_heights: np.ndarray, stance_height: float) -> np.ndarray:

@@ -26,15 +26,15 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from avatar_models.body17 import BODY17
-from avatar_models.errors import MotionValueError
-from sim.control import balance
-from sim.control.falls import fallen, first_fall
-from sim.control.model import BodyIndices, is_control_model
-from sim.control.qp import WholeBodyQP
-from sim.control.records import FrameRecord, Recording
-from sim.control.reference import Reference, ReferencePoint
-from sim.control.settings import ControlSettings
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.sim.control import balance
+from avatarsim.sim.control.falls import fallen, first_fall
+from avatarsim.sim.control.model import BodyIndices, is_control_model
+from avatarsim.sim.control.qp import WholeBodyQP
+from avatarsim.sim.control.records import FrameRecord, Recording
+from avatarsim.sim.control.reference import Reference, ReferencePoint
+from avatarsim.sim.control.settings import ControlSettings
 
 
 @dataclass(frozen=True)
@@ -119,7 +119,7 @@ class Controller:
         if not is_control_model(model):
             raise MotionValueError(
                 "Controller needs the humanoid's control variant (motors, floor contacts): "
-                "pass sim.control.model.control_model(spec) or Humanoid.control_model()"
+                "pass avatarsim.sim.control.model.control_model(spec) or Humanoid.control_model()"
             )
         self.settings = settings or ControlSettings()
         self.model = model

@@ -16,9 +16,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import quat
-from avatar_models.body17 import BODY17
-from sim.control.settings import ControlSettings
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.sim.control.settings import ControlSettings
 
 HEAD = BODY17.index("head")
 UP = np.array([0.0, 0.0, 1.0])

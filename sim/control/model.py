@@ -11,10 +11,10 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from avatar_models.body import control_spec
-from avatar_models.body17 import BODY17
-from avatar_models.errors import MotionValueError
-from sim.soles import ANKLE_SITES, box_corners, foot_bodies, sole_boxes, thigh_bodies
+from avatarsim.avatar_models.body import control_spec
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.sim.soles import ANKLE_SITES, box_corners, foot_bodies, sole_boxes, thigh_bodies
 
 
 def control_model(spec: mujoco.MjSpec) -> mujoco.MjModel:

@@ -35,9 +35,9 @@ import mujoco
 import numpy as np
 from qpsolvers import solve_qp
 
-from sim.control.model import BodyIndices
-from sim.control.settings import ROOT_DOF, ControlSettings
-from sim.soles import corner_positions
+from avatarsim.sim.control.model import BodyIndices
+from avatarsim.sim.control.settings import ROOT_DOF, ControlSettings
+from avatarsim.sim.soles import corner_positions
 
 QP_SOLVER = "daqp"
 

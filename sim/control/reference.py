@@ -14,11 +14,11 @@ import numpy as np
 from scipy.ndimage import gaussian_filter1d
 from scipy.spatial.distance import cdist
 
-from avatar_models import quat
-from avatar_models.errors import MotionValueError
-from sim.control.balance import swing_weights
-from sim.control.model import BodyIndices
-from sim.control.settings import ControlSettings
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.sim.control.balance import swing_weights
+from avatarsim.sim.control.model import BodyIndices
+from avatarsim.sim.control.settings import ControlSettings
 
 
 @dataclass(frozen=True)

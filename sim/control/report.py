@@ -11,9 +11,9 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.body17 import BODY17
-from avatar_models.fileio import write_columns_csv, write_json
-from sim.control.controller import ControlResult
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.avatar_models.fileio import write_columns_csv, write_json
+from avatarsim.sim.control.controller import ControlResult
 
 
 def per_frame(result: ControlResult) -> dict[str, np.ndarray]:

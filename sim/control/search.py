@@ -34,12 +34,12 @@ import mujoco
 import numpy as np
 from tqdm import tqdm
 
-from avatar_models.body17 import BODY17
-from sim.control.controller import Controller, ControlResult, Progress
-from sim.control.falls import HEAD, fallen, tilt_deg
-from sim.control.reference import Reference
-from sim.control.settings import ControlSettings
-from sim.soles import subtree_mask, thigh_bodies
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.sim.control.controller import Controller, ControlResult, Progress
+from avatarsim.sim.control.falls import HEAD, fallen, tilt_deg
+from avatarsim.sim.control.reference import Reference
+from avatarsim.sim.control.settings import ControlSettings
+from avatarsim.sim.soles import subtree_mask, thigh_bodies
 
 PELVIS = BODY17.index("pelvis")
 STATE = mujoco.mjtState.mjSTATE_INTEGRATION

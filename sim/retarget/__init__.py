@@ -18,14 +18,14 @@ from typing import NamedTuple
 import mujoco
 import numpy as np
 
-from avatar_models.body import BodyDescription
-from avatar_models.body.ik import HumanoidIK, IKSettings, humanoid_model, motion_from_qpos
-from avatar_models.body17 import BODY17
-from avatar_models.errors import MotionValueError, RigError
-from avatar_models.measure import standing_height
-from avatar_models.motion import Motion
-from avatar_models.rigs import body17_positions
-from sim.retarget.feet import (
+from avatarsim.avatar_models.body import BodyDescription
+from avatarsim.avatar_models.body.ik import HumanoidIK, IKSettings, humanoid_model, motion_from_qpos
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.avatar_models.errors import MotionValueError, RigError
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.sim.retarget.feet import (
     clear_swing_feet,
     level_stance_feet,
     lift_toes,
@@ -34,7 +34,7 @@ from sim.retarget.feet import (
     stance_feet,
     swinging_feet,
 )
-from sim.retarget.sizing import humanoid_body
+from avatarsim.sim.retarget.sizing import humanoid_body
 
 __all__ = ["Retargeted", "retarget"]
 

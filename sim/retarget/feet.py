@@ -28,11 +28,11 @@ import mujoco
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
-from avatar_models.body.ik import HumanoidIK, IKSettings
-from avatar_models.body17 import BODY17, INDEX
-from avatar_models.foot_contact import contact_mask, horizontal_speed
-from sim.soles import (
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body.ik import HumanoidIK, IKSettings
+from avatarsim.avatar_models.body17 import BODY17, INDEX
+from avatarsim.avatar_models.foot_contact import contact_mask, horizontal_speed
+from avatarsim.sim.soles import (
     box_corners,
     corner_positions,
     foot_bodies,

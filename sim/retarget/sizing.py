@@ -15,11 +15,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.body import BodyDescription, build_body
-from avatar_models.body.anatomy import classify
-from avatar_models.body17 import INDEX
-from avatar_models.motion import Motion
-from avatar_models.rigs import body17_positions, load_rig
+from avatarsim.avatar_models.body import BodyDescription, build_body
+from avatarsim.avatar_models.body.anatomy import classify
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.rigs import body17_positions, load_rig
 
 TEMPLATE_RIG = "avatar"
 SEGMENT_SPANS: dict[str, tuple[tuple[str, str], ...]] = {

@@ -8,13 +8,13 @@ eqs. 5-7), :mod:`.synthesizer` (the ``AvatarGo`` Synthesizer) and :mod:`.study` 
 users, §4-5).
 """
 
-from synthesis.avatargo.calibration import (
+from avatarsim.synthesis.avatargo.calibration import (
     CalibrationError,
     MissingDeviceError,
     NotTPoseError,
     SwappedTrackersError,
 )
-from synthesis.avatargo.synthesizer import AvatarGo
+from avatarsim.synthesis.avatargo.synthesizer import AvatarGo
 
 __all__ = [
     "AvatarGo",

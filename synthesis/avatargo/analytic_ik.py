@@ -53,9 +53,9 @@ from typing import NamedTuple
 import mujoco
 import numpy as np
 
-from avatar_models import quat
-from avatar_models.body import BodyDescription
-from synthesis.two_bone import solve as two_bone
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body import BodyDescription
+from avatarsim.synthesis.two_bone import solve as two_bone
 
 LIMBS = (
     ("l_hip", "l_knee", "l_ankle"),

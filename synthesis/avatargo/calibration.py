@@ -29,9 +29,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import CalibrationError, quat
-from render_cams.vr import FULL_BODY
-from synthesis.base import SynthesisError
+from avatarsim.avatar_models import CalibrationError, quat
+from avatarsim.render_cams.vr import FULL_BODY
+from avatarsim.synthesis.base import SynthesisError
 
 NEEDED = {"hmd": 1, "controller": 2, "tracker": 3}
 """How many devices of each SteamVR class AvatarGo needs (§3.1)."""

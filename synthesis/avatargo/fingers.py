@@ -32,8 +32,8 @@ from functools import cached_property
 
 import numpy as np
 
-from avatar_models import Skeleton, quat
-from synthesis.avatargo.hands import CONTROLLER_RADIUS_M, PALM_NORMAL, Grip, finger_joint
+from avatarsim.avatar_models import Skeleton, quat
+from avatarsim.synthesis.avatargo.hands import CONTROLLER_RADIUS_M, PALM_NORMAL, Grip, finger_joint
 
 CLOSED_DEG = np.array([[15.0, 50.0, 80.0], *[[90.0, 100.0, 90.0]] * 4])
 """Closed angle of each joint (degrees), thumb first then index to little finger: the AAOS

@@ -23,10 +23,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import Skeleton, quat
-from avatar_models.rigs import identify_rig
-from render_cams.vr import nominal_attachment
-from synthesis.avatargo.offsets import TrackerOffsets
+from avatarsim.avatar_models import Skeleton, quat
+from avatarsim.avatar_models.rigs import identify_rig
+from avatarsim.render_cams.vr import nominal_attachment
+from avatarsim.synthesis.avatargo.offsets import TrackerOffsets
 
 CONTROLLER_RADIUS_M = 0.02
 HANDLE_LENGTH_M = 0.10

@@ -33,9 +33,9 @@ import mujoco
 import numpy as np
 from scipy.linalg import cho_factor, cho_solve
 
-from avatar_models import quat
-from avatar_models.body.errors import BodyError
-from avatar_models.body.ik import ROOT_NQ, HumanoidIK
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body.errors import BodyError
+from avatarsim.avatar_models.body.ik import ROOT_NQ, HumanoidIK
 
 ROOT_NV = 6
 ACTIVE_SET_PASSES = 4

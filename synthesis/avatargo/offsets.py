@@ -25,8 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import quat
-from render_cams.vr import Attachment
+from avatarsim.avatar_models import quat
+from avatarsim.render_cams.vr import Attachment
 
 
 @dataclass(frozen=True, eq=False)

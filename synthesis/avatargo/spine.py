@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from synthesis.two_bone import shortest_arc, unit, unit_arc
+from avatarsim.synthesis.two_bone import shortest_arc, unit, unit_arc
 
 
 def bend_angle(w0: np.ndarray, w: np.ndarray) -> np.ndarray:

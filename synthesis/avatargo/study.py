@@ -38,12 +38,12 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from avatar_models import Motion, Skeleton, quat
-from avatar_models.body import build_body
-from avatar_models.rigs import identify_rig
-from render_cams.vr import FULL_BODY, Attachment, NoiseModel, VRSetup, nominal_attachment
-from synthesis.avatargo.synthesizer import ANALYTIC, AvatarGo
-from synthesis.avatargo.walk_in import walk_in
+from avatarsim.avatar_models import Motion, Skeleton, quat
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.rigs import identify_rig
+from avatarsim.render_cams.vr import FULL_BODY, Attachment, NoiseModel, VRSetup, nominal_attachment
+from avatarsim.synthesis.avatargo.synthesizer import ANALYTIC, AvatarGo
+from avatarsim.synthesis.avatargo.walk_in import walk_in
 
 PROXY = (
     "geometric proxy: avatar joints against the simulated user's own joints (cm) and knee "

@@ -66,16 +66,16 @@ import mujoco
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from avatar_models import Motion, Skeleton, quat
-from avatar_models.body import BodyDescription, build_body
-from avatar_models.body.ik import HumanoidIK, IKSettings, motion_from_qpos
-from avatar_models.rigs import identify_rig
-from render_cams import TrackingStream
-from render_cams.vr import FULL_BODY, Attachment, nominal_attachment
-from synthesis.avatargo.analytic_ik import LEGS, AnalyticGoals, AnalyticIK
-from synthesis.avatargo.calibration import Roles, classes_of, identify_roles
-from synthesis.avatargo.fingers import FingerIK
-from synthesis.avatargo.hands import (
+from avatarsim.avatar_models import Motion, Skeleton, quat
+from avatarsim.avatar_models.body import BodyDescription, build_body
+from avatarsim.avatar_models.body.ik import HumanoidIK, IKSettings, motion_from_qpos
+from avatarsim.avatar_models.rigs import identify_rig
+from avatarsim.render_cams import TrackingStream
+from avatarsim.render_cams.vr import FULL_BODY, Attachment, nominal_attachment
+from avatarsim.synthesis.avatargo.analytic_ik import LEGS, AnalyticGoals, AnalyticIK
+from avatarsim.synthesis.avatargo.calibration import Roles, classes_of, identify_roles
+from avatarsim.synthesis.avatargo.fingers import FingerIK
+from avatarsim.synthesis.avatargo.hands import (
     Grip,
     beyond_reach,
     grip_of,
@@ -84,10 +84,10 @@ from synthesis.avatargo.hands import (
     palm_distance,
     palm_offsets,
 )
-from synthesis.avatargo.least_squares_ik import LeastSquaresIK
-from synthesis.avatargo.offsets import TrackerOffsets, exact_offsets, fixed_offsets
-from synthesis.avatargo.spine import spine_bend, spine_bend_in_root
-from synthesis.base import (
+from avatarsim.synthesis.avatargo.least_squares_ik import LeastSquaresIK
+from avatarsim.synthesis.avatargo.offsets import TrackerOffsets, exact_offsets, fixed_offsets
+from avatarsim.synthesis.avatargo.spine import spine_bend, spine_bend_in_root
+from avatarsim.synthesis.base import (
     DEFAULT_RATE_HZ,
     FrameBatch,
     Poses,
@@ -95,7 +95,7 @@ from synthesis.base import (
     Synthesizer,
     TrackingFrame,
 )
-from synthesis.two_bone import unit
+from avatarsim.synthesis.two_bone import unit
 
 SITES = ("head", "l_ankle", "r_ankle", "pelvis", "neck", "l_wrist", "r_wrist")
 """The humanoid's body17 sites the IK steers, in goal order: the tracked joints first, in

@@ -21,12 +21,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import Motion, Skeleton, quat
-from avatar_models.body import build_body
-from avatar_models.rigs import identify_rig
-from render_cams.vr import VRSetup
-from synthesis.base import TrackingFrame
-from synthesis.ik_baseline import body_frame, rest_body_frame, stands_upright
+from avatarsim.avatar_models import Motion, Skeleton, quat
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.rigs import identify_rig
+from avatarsim.render_cams.vr import VRSetup
+from avatarsim.synthesis.base import TrackingFrame
+from avatarsim.synthesis.ik_baseline import body_frame, rest_body_frame, stands_upright
 
 WALK_IN_S = 0.5
 """How long the user stands in the T-pose before the trigger (the sample is the last one)."""

@@ -23,10 +23,14 @@ from typing import Any
 import numpy as np
 import torch
 
-from synthesis.controllerpose.checkpoint_schema import FORMAT, CheckpointError, check_payload
-from synthesis.controllerpose.features import LAYOUT
-from synthesis.controllerpose.network import LiftingNet, NetConfig
-from synthesis.controllerpose.normaliser import Normaliser
+from avatarsim.synthesis.controllerpose.checkpoint_schema import (
+    FORMAT,
+    CheckpointError,
+    check_payload,
+)
+from avatarsim.synthesis.controllerpose.features import LAYOUT
+from avatarsim.synthesis.controllerpose.network import LiftingNet, NetConfig
+from avatarsim.synthesis.controllerpose.normaliser import Normaliser
 
 FILE = "checkpoint.pt"
 __all__ = ["FILE", "Checkpoint", "CheckpointError", "load", "untrained"]

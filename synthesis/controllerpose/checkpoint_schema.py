@@ -28,10 +28,10 @@ from typing import Any
 
 import torch
 
-from avatar_models import AvatarsimError
-from avatar_models.body17 import BODY17
-from synthesis.controllerpose.features import LAYOUT
-from synthesis.controllerpose.network import ConfigValueError, LiftingNet, NetConfig
+from avatarsim.avatar_models import AvatarsimError
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.synthesis.controllerpose.features import LAYOUT
+from avatarsim.synthesis.controllerpose.network import ConfigValueError, LiftingNet, NetConfig
 
 FORMAT = 2
 """Version of the file's payload. 1 stored numpy arrays, which only a full unpickler reads."""

@@ -14,11 +14,11 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from avatar_models.body17 import BODY17, INDEX
-from synthesis.controllerpose.checkpoint import Checkpoint
-from synthesis.controllerpose.examples import Examples
-from synthesis.controllerpose.fk import forward_kinematics
-from synthesis.controllerpose.train import predict, tensors
+from avatarsim.avatar_models.body17 import BODY17, INDEX
+from avatarsim.synthesis.controllerpose.checkpoint import Checkpoint
+from avatarsim.synthesis.controllerpose.examples import Examples
+from avatarsim.synthesis.controllerpose.fk import forward_kinematics
+from avatarsim.synthesis.controllerpose.train import predict, tensors
 
 NORMALISED_HEIGHT_M = 1.8  # §5.3
 HIP_AND_TORSO = ("pelvis", "l_hip", "r_hip", "neck")

@@ -14,10 +14,10 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from avatar_models import quat
-from avatar_models.body17_angles import angles_from_positions
-from render_cams.vr import HEADSET_AND_CONTROLLERS
-from synthesis.controllerpose.features import (
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body17_angles import angles_from_positions
+from avatarsim.render_cams.vr import HEADSET_AND_CONTROLLERS
+from avatarsim.synthesis.controllerpose.features import (
     FeatureError,
     Features,
     heading_matrix,

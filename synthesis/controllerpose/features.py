@@ -30,8 +30,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import AvatarsimError, quat
-from avatar_models.body17_angles import DOF_SLICES, ROOT, matrix_to_rotvec, rotvec_to_matrix
+from avatarsim.avatar_models import AvatarsimError, quat
+from avatarsim.avatar_models.body17_angles import (
+    DOF_SLICES,
+    ROOT,
+    matrix_to_rotvec,
+    rotvec_to_matrix,
+)
 
 N_KEYPOINTS = 17
 PAIRS = np.triu_indices(N_KEYPOINTS, 1)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import torch
 
-from avatar_models.body17_angles import (
+from avatarsim.avatar_models.body17_angles import (
     DOF_SLICES,
     FK_ORDER,
     HINGES,

@@ -20,9 +20,9 @@ from numbers import Integral, Real
 import torch
 from torch import nn
 
-from avatar_models.body17_angles import N_DOF
-from synthesis.base import SynthesisError
-from synthesis.controllerpose.features import PER_SKELETON, SKELETON_SLOTS, VR_FEATURES
+from avatarsim.avatar_models.body17_angles import N_DOF
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.controllerpose.features import PER_SKELETON, SKELETON_SLOTS, VR_FEATURES
 
 
 class ConfigValueError(SynthesisError):

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from synthesis.controllerpose.features import Features
+from avatarsim.synthesis.controllerpose.features import Features
 
 MIN_STD = 1e-3  # a feature constant in training (e.g. an always-missing pair) is not scaled up
 

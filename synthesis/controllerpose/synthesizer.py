@@ -27,18 +27,22 @@ import numpy as np
 import torch
 from threadpoolctl import threadpool_limits
 
-from avatar_models import Motion, Skeleton, quat
-from avatar_models.body import build_body
-from avatar_models.body.ik import HumanoidIK, IKSettings, humanoid_model, motion_from_qpos
-from avatar_models.body17 import BODY17, INDEX
-from avatar_models.measure import standing_height
-from render_cams import TrackingStream
-from render_cams.vr import HEADSET_AND_CONTROLLERS, nominal_attachment
-from synthesis.base import DEFAULT_RATE_HZ, FrameBatch, Poses, SynthesisError, Synthesizer
-from synthesis.controllerpose.checkpoint import FILE, Checkpoint, load
-from synthesis.controllerpose.examples import VRStream, frame_features
-from synthesis.controllerpose.features import SKELETON_SLOTS, heading_matrix, latest_sample
-from synthesis.controllerpose.fk import forward_kinematics
+from avatarsim.avatar_models import Motion, Skeleton, quat
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.body.ik import HumanoidIK, IKSettings, humanoid_model, motion_from_qpos
+from avatarsim.avatar_models.body17 import BODY17, INDEX
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.render_cams import TrackingStream
+from avatarsim.render_cams.vr import HEADSET_AND_CONTROLLERS, nominal_attachment
+from avatarsim.synthesis.base import DEFAULT_RATE_HZ, FrameBatch, Poses, SynthesisError, Synthesizer
+from avatarsim.synthesis.controllerpose.checkpoint import FILE, Checkpoint, load
+from avatarsim.synthesis.controllerpose.examples import VRStream, frame_features
+from avatarsim.synthesis.controllerpose.features import (
+    SKELETON_SLOTS,
+    heading_matrix,
+    latest_sample,
+)
+from avatarsim.synthesis.controllerpose.fk import forward_kinematics
 
 MODEL_ENV = "AVATARSIM_CONTROLLERPOSE_MODEL"
 DEFAULT_MODEL = Path("out/controllerpose")

@@ -20,12 +20,12 @@ import numpy as np
 import torch
 from torch import nn
 
-from synthesis.base import SynthesisError
-from synthesis.controllerpose.checkpoint import Checkpoint
-from synthesis.controllerpose.examples import Examples
-from synthesis.controllerpose.fk import forward_kinematics
-from synthesis.controllerpose.network import LiftingNet, NetConfig, check_int, check_real
-from synthesis.controllerpose.normaliser import Normaliser
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.controllerpose.checkpoint import Checkpoint
+from avatarsim.synthesis.controllerpose.examples import Examples
+from avatarsim.synthesis.controllerpose.fk import forward_kinematics
+from avatarsim.synthesis.controllerpose.network import LiftingNet, NetConfig, check_int, check_real
+from avatarsim.synthesis.controllerpose.normaliser import Normaliser
 
 EVAL_CHUNK = 4096
 

@@ -12,14 +12,14 @@ skating of the output). Accuracy against the ground truth
 is :mod:`synthesis.scoring`.
 """
 
-from synthesis.coolmoves.database import (
+from avatarsim.synthesis.coolmoves.database import (
     FEET_DRIVE,
     HANDS_DRIVE,
     Database,
     Drivers,
     build_database,
 )
-from synthesis.coolmoves.synthesizer import CoolMoves, Options
+from avatarsim.synthesis.coolmoves.synthesizer import CoolMoves, Options
 
 __all__ = [
     "FEET_DRIVE",

@@ -6,9 +6,9 @@ and lives in :mod:`synthesis.scoring`.
 
 from __future__ import annotations
 
-from avatar_models import Motion, body17
-from avatar_models.rigs import body17_positions
-from synthesis.coolmoves import foot_contact
+from avatarsim.avatar_models import Motion, body17
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.synthesis.coolmoves import foot_contact
 
 _ANKLES = ("l_ankle", "r_ankle")
 

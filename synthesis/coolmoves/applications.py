@@ -18,11 +18,17 @@ from collections.abc import Sequence
 import numpy as np
 from scipy.signal import lfilter
 
-from avatar_models import Motion
-from avatar_models.library import MotionLibrary
-from render_cams import TrackingStream
-from synthesis.base import SynthesisError, on_clock, usable_mask
-from synthesis.coolmoves.database import FEET_DRIVE, HANDS_DRIVE, Database, Drivers, labels
+from avatarsim.avatar_models import Motion
+from avatarsim.avatar_models.library import MotionLibrary
+from avatarsim.render_cams import TrackingStream
+from avatarsim.synthesis.base import SynthesisError, on_clock, usable_mask
+from avatarsim.synthesis.coolmoves.database import (
+    FEET_DRIVE,
+    HANDS_DRIVE,
+    Database,
+    Drivers,
+    labels,
+)
 
 CENTRE_TIME_CONSTANT_S = 1.0
 """Centre of a hand's motion: the average over about the last second (our choice)."""

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import quat
+from avatarsim.avatar_models import quat
 
 _EPS_M = 1e-9  # keeps an exact (distance 0) match finite; it then takes all the weight
 

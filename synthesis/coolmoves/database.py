@@ -22,14 +22,14 @@ from typing import Any
 
 import numpy as np
 
-from avatar_models import Motion, Skeleton, quat
-from avatar_models.library import MotionLibrary
-from avatar_models.rigs import RigError, identify_rig
-from render_cams.device import motion_at_rate
-from render_cams.vr import attachment_poses, nominal_attachment
-from synthesis.base import SynthesisError
-from synthesis.coolmoves import correlation
-from synthesis.coolmoves.features import (
+from avatarsim.avatar_models import Motion, Skeleton, quat
+from avatarsim.avatar_models.library import MotionLibrary
+from avatarsim.avatar_models.rigs import RigError, identify_rig
+from avatarsim.render_cams.device import motion_at_rate
+from avatarsim.render_cams.vr import attachment_poses, nominal_attachment
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.coolmoves import correlation
+from avatarsim.synthesis.coolmoves.features import (
     RATE_HZ,
     SPEED_FACTORS,
     WINDOW_SAMPLES,

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.foot_contact import contact_mask
+from avatarsim.avatar_models.foot_contact import contact_mask
 
 CONTACT_HEIGHT_M = 0.05
 """Foot-contact height of UHC and PhysDiff (5 cm), above the ankle's standing height."""

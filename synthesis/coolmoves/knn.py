@@ -25,7 +25,7 @@ from collections.abc import Sequence
 import numpy as np
 from scipy.spatial import cKDTree
 
-from synthesis.coolmoves.blend import inverse_distance_weights
+from avatarsim.synthesis.coolmoves.blend import inverse_distance_weights
 
 K_NEIGHBOURS = 5
 """Matches per hand, as in the paper's Fig. 3 ("top 5 matches")."""

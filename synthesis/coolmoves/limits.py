@@ -19,11 +19,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import Skeleton
-from avatar_models.body.anatomy import classify
-from avatar_models.body.joint_ranges import euler_order
-from avatar_models.quat import euler_axes, euler_key, from_euler, to_euler
-from avatar_models.rigs import RigError, identify_rig
+from avatarsim.avatar_models import Skeleton
+from avatarsim.avatar_models.body.anatomy import classify
+from avatarsim.avatar_models.body.joint_ranges import euler_order
+from avatarsim.avatar_models.quat import euler_axes, euler_key, from_euler, to_euler
+from avatarsim.avatar_models.rigs import RigError, identify_rig
 
 _DEFAULT_ORDER = "XYZ"
 

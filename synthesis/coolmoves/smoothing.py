@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import quat
+from avatarsim.avatar_models import quat
 
 
 def ewma_step(previous: np.ndarray, current: np.ndarray, weight: np.ndarray) -> np.ndarray:

@@ -28,28 +28,28 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import Skeleton
-from avatar_models.body.description import UPRIGHT_RATIO
-from avatar_models.measure import standing_height
-from avatar_models.rigs import identify_rig
-from render_cams.vr import nominal_attachment
-from synthesis.base import FrameBatch, Poses, SynthesisError, Synthesizer
-from synthesis.coolmoves.alignment import alignment_yaw, turn_about_vertical
-from synthesis.coolmoves.blend import (
+from avatarsim.avatar_models import Skeleton
+from avatarsim.avatar_models.body.description import UPRIGHT_RATIO
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.rigs import identify_rig
+from avatarsim.render_cams.vr import nominal_attachment
+from avatarsim.synthesis.base import FrameBatch, Poses, SynthesisError, Synthesizer
+from avatarsim.synthesis.coolmoves.alignment import alignment_yaw, turn_about_vertical
+from avatarsim.synthesis.coolmoves.blend import (
     blend_rotations,
     global_match_weight,
     group_shares,
     group_weights,
     joint_groups,
 )
-from synthesis.coolmoves.database import Database
-from synthesis.coolmoves.features import RATE_HZ, search_vectors, sliding_windows
-from synthesis.coolmoves.foot_contact import FootContact
-from synthesis.coolmoves.knn import K_NEIGHBOURS, MAX_DISTANCE, BothHandsKNN, PerHand
-from synthesis.coolmoves.limits import JointLimits
-from synthesis.coolmoves.smoothing import ewma
-from synthesis.two_bone import chain_fk
-from synthesis.two_bone import solve as two_bone
+from avatarsim.synthesis.coolmoves.database import Database
+from avatarsim.synthesis.coolmoves.features import RATE_HZ, search_vectors, sliding_windows
+from avatarsim.synthesis.coolmoves.foot_contact import FootContact
+from avatarsim.synthesis.coolmoves.knn import K_NEIGHBOURS, MAX_DISTANCE, BothHandsKNN, PerHand
+from avatarsim.synthesis.coolmoves.limits import JointLimits
+from avatarsim.synthesis.coolmoves.smoothing import ewma
+from avatarsim.synthesis.two_bone import chain_fk
+from avatarsim.synthesis.two_bone import solve as two_bone
 
 EYE_HEIGHT_FRAC = 0.936
 ANKLE_HEIGHT_FRAC = 0.039
@@ -224,7 +224,7 @@ class CoolMoves(Synthesizer):
         if opts.matcher == "knn":
             return BothHandsKNN(db.search, opts.k, opts.max_distance)
         if opts.matcher == "gmm":
-            from synthesis.coolmoves.gmm import GaussianMixtureMatcher
+            from avatarsim.synthesis.coolmoves.gmm import GaussianMixtureMatcher
 
             return PerHand(
                 GaussianMixtureMatcher(db.search[s], opts.k, opts.max_distance) for s in (0, 1)

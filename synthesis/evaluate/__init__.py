@@ -7,8 +7,8 @@ database) and :mod:`.protocol` (running and aggregating them). Scoring a run is
 :func:`synthesis.scoring.score_run`, shared with the scenarios and the benchmarks.
 """
 
-from synthesis.evaluate.folds import PROTOCOLS, Fold, database_for, folds
-from synthesis.evaluate.protocol import (
+from avatarsim.synthesis.evaluate.folds import PROTOCOLS, Fold, database_for, folds
+from avatarsim.synthesis.evaluate.protocol import (
     ABLATION,
     EVALUABLE,
     PAPER,
@@ -18,7 +18,7 @@ from synthesis.evaluate.protocol import (
     run_protocol,
     summarise,
 )
-from synthesis.evaluate.trials import (
+from avatarsim.synthesis.evaluate.trials import (
     PAPER_ACTIVITIES,
     TAKE_VARIATION,
     EvaluationError,

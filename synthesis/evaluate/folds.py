@@ -14,10 +14,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import Skeleton
-from avatar_models.rigs import identify_rig
-from synthesis.coolmoves import Database, build_database, correlation
-from synthesis.evaluate.trials import EvaluationError, Trial
+from avatarsim.avatar_models import Skeleton
+from avatarsim.avatar_models.rigs import identify_rig
+from avatarsim.synthesis.coolmoves import Database, build_database, correlation
+from avatarsim.synthesis.evaluate.trials import EvaluationError, Trial
 
 PROTOCOLS = ("cross-subject", "cross-trial")
 

@@ -18,20 +18,20 @@ from dataclasses import replace
 
 import numpy as np
 
-from avatar_models import Motion, Skeleton
-from avatar_models.measure import standing_height
-from avatar_models.rigs import load_rig
-from render_cams import VRSetup
-from render_cams.vr import HEADSET_AND_CONTROLLERS, Attachment
-from synthesis.base import SynthesisError
-from synthesis.coolmoves import CoolMoves, Database
-from synthesis.coolmoves.correlation import CORRELATION_THRESHOLD
-from synthesis.evaluate.folds import Fold, database_for, folds
-from synthesis.evaluate.trials import EvaluationError, Trial, turned
-from synthesis.evaluate.validation import choose_max_distance
-from synthesis.ik_baseline import IKBaseline, attachments_on_upright_rig, stands_upright
-from synthesis.methods import METHODS, Method
-from synthesis.scoring import GROUPS, score_run
+from avatarsim.avatar_models import Motion, Skeleton
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.render_cams import VRSetup
+from avatarsim.render_cams.vr import HEADSET_AND_CONTROLLERS, Attachment
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.coolmoves import CoolMoves, Database
+from avatarsim.synthesis.coolmoves.correlation import CORRELATION_THRESHOLD
+from avatarsim.synthesis.evaluate.folds import Fold, database_for, folds
+from avatarsim.synthesis.evaluate.trials import EvaluationError, Trial, turned
+from avatarsim.synthesis.evaluate.validation import choose_max_distance
+from avatarsim.synthesis.ik_baseline import IKBaseline, attachments_on_upright_rig, stands_upright
+from avatarsim.synthesis.methods import METHODS, Method
+from avatarsim.synthesis.scoring import GROUPS, score_run
 
 EVALUABLE = tuple(name for name, m in METHODS.items() if m.options is not None)
 """The registered methods this protocol evaluates (the CoolMoves variants, the IK baseline

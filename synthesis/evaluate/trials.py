@@ -15,10 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models import Motion
-from avatar_models.generator import Subject, generate, sample_subject
-from avatar_models.library import MotionLibrary
-from synthesis.base import SynthesisError
+from avatarsim.avatar_models import Motion
+from avatarsim.avatar_models.generator import Subject, generate, sample_subject
+from avatarsim.avatar_models.library import MotionLibrary
+from avatarsim.synthesis.base import SynthesisError
 
 PAPER_ACTIVITIES = ("box", "dribble", "climb_ladder", "run", "swim")
 """The generator's counterparts of the paper's Table 1 (boxing, basketball, climbing a ladder,

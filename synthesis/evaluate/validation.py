@@ -15,13 +15,13 @@ from dataclasses import replace
 
 import numpy as np
 
-from avatar_models.measure import standing_height
-from render_cams import VRSetup
-from synthesis.base import SynthesisError
-from synthesis.coolmoves import CoolMoves, Options
-from synthesis.evaluate.folds import database_for, group_of
-from synthesis.evaluate.trials import Trial
-from synthesis.scoring import score_run
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.render_cams import VRSetup
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.coolmoves import CoolMoves, Options
+from avatarsim.synthesis.evaluate.folds import database_for, group_of
+from avatarsim.synthesis.evaluate.trials import Trial
+from avatarsim.synthesis.scoring import score_run
 
 DISTANCE_GRID = (0.3, 0.6, 1.2)
 """Candidate thresholds, in the units of :mod:`synthesis.coolmoves.features` (metres over

@@ -14,6 +14,6 @@ recording and playback, loops, masks, resizing, lip sync and blinking.
 - :mod:`.storytelling`: several takes staged in one scene, an MJCF scene of it.
 """
 
-from synthesis.movebox.synthesizer import MoveBox, check_stream
+from avatarsim.synthesis.movebox.synthesizer import MoveBox, check_stream
 
 __all__ = ["MoveBox", "check_stream"]

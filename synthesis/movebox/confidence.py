@@ -22,8 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import quat
-from render_cams.kinect import TrackingState
+from avatarsim.avatar_models import quat
+from avatarsim.render_cams.kinect import TrackingState
 
 INFERRED_WEIGHT = 0.5
 """Share of an Inferred estimate in the bone's rotation (our choice; the paper gives none)."""

@@ -32,8 +32,8 @@ from pathlib import Path
 import numpy as np
 from scipy.io import wavfile
 
-from avatar_models import Motion, Skeleton, quat
-from synthesis.base import SynthesisError
+from avatarsim.avatar_models import Motion, Skeleton, quat
+from avatarsim.synthesis.base import SynthesisError
 
 JAW_BAND_HZ = (80.0, 1000.0)
 LIP_BAND_HZ = (1000.0, 4000.0)

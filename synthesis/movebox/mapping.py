@@ -26,7 +26,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from synthesis.base import SynthesisError
+from avatarsim.synthesis.base import SynthesisError
 
 
 @dataclass(frozen=True)

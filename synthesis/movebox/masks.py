@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from avatar_models import Motion, Skeleton
-from synthesis.base import SynthesisError
+from avatarsim.avatar_models import Motion, Skeleton
+from avatarsim.synthesis.base import SynthesisError
 
 FACE_PARTS = ("Jaw", "Eyelid")
 UPPER_ROOT = "Bip01 Spine"

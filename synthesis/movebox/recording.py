@@ -15,11 +15,11 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models import Motion, Skeleton
-from avatar_models.formats import load_motion, save_motion
-from avatar_models.rigs import identify_rig
-from synthesis.base import SynthesisError
-from synthesis.movebox.similarity import loop_points
+from avatarsim.avatar_models import Motion, Skeleton
+from avatarsim.avatar_models.formats import load_motion, save_motion
+from avatarsim.avatar_models.rigs import identify_rig
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.movebox.similarity import loop_points
 
 
 def hip_height(skeleton: Skeleton) -> float:

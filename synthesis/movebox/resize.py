@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import Skeleton
-from avatar_models.measure import standing_height
-from avatar_models.rigs import identify_rig, load_rig
-from render_cams.kinect import KinectSkeletonStream, TrackingState
-from synthesis.base import SynthesisError
+from avatarsim.avatar_models import Skeleton
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.rigs import identify_rig, load_rig
+from avatarsim.render_cams.kinect import KinectSkeletonStream, TrackingState
+from avatarsim.synthesis.base import SynthesisError
 
 AVATAR_JOINTS = ("Bip01 Pelvis", "Bip01 Spine", "Bip01 L UpperArm", "Bip01 R Thigh")
 """Joints that tell an avatar-rig skeleton (the 3ds Max Biped names)."""

@@ -36,9 +36,9 @@ from functools import cached_property
 
 import numpy as np
 
-from avatar_models import Skeleton, quat
-from synthesis.base import SynthesisError
-from synthesis.movebox.mapping import NECK, PELVIS, PELVIS_TRIAD, BoneDrive, RigMapping
+from avatarsim.avatar_models import Skeleton, quat
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.movebox.mapping import NECK, PELVIS, PELVIS_TRIAD, BoneDrive, RigMapping
 
 ROLLS = ("hinge", "rest", "sensor")
 BEND_FADE = (0.1, 0.3)

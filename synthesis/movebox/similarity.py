@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import quat
-from synthesis.base import SynthesisError
+from avatarsim.avatar_models import quat
+from avatarsim.synthesis.base import SynthesisError
 
 PAIR_BLOCK = 256
 """Rows of the pair matrix computed at once (bounds memory to ``256 x M x J`` floats)."""

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import lfilter
 
-from avatar_models import quat
+from avatarsim.avatar_models import quat
 
 TIME_CONSTANT_S = 1.0 / 30.0
 """Smoothing time constant: one Kinect frame (our choice; the paper gives no value). It

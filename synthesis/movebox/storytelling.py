@@ -18,12 +18,12 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from avatar_models import Motion, quat
-from synthesis.base import SynthesisError
-from synthesis.movebox.face import LipSync, blinks, face_motion
-from synthesis.movebox.masks import Layer, compose
-from synthesis.movebox.recording import looped
-from synthesis.movebox.retarget import shortest_arc
+from avatarsim.avatar_models import Motion, quat
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.movebox.face import LipSync, blinks, face_motion
+from avatarsim.synthesis.movebox.masks import Layer, compose
+from avatarsim.synthesis.movebox.recording import looped
+from avatarsim.synthesis.movebox.retarget import shortest_arc
 
 MIN_BONE_M = 0.02
 """Bones shorter than this are not drawn (finger joints, face)."""

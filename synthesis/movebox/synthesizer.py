@@ -20,14 +20,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import Motion, Skeleton, quat
-from avatar_models.rigs import load_rig
-from render_cams.kinect import KinectSkeletonStream, TrackingState
-from synthesis.base import DEFAULT_RATE_HZ, FrameBatch, Poses, SynthesisError, Synthesizer
-from synthesis.movebox.confidence import ConfidenceFilter, bone_states, forward_fill
-from synthesis.movebox.mapping import PELVIS, mapping_for
-from synthesis.movebox.retarget import ROLLS, Retargeting
-from synthesis.movebox.smoothing import (
+from avatarsim.avatar_models import Motion, Skeleton, quat
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.render_cams.kinect import KinectSkeletonStream, TrackingState
+from avatarsim.synthesis.base import DEFAULT_RATE_HZ, FrameBatch, Poses, SynthesisError, Synthesizer
+from avatarsim.synthesis.movebox.confidence import ConfidenceFilter, bone_states, forward_fill
+from avatarsim.synthesis.movebox.mapping import PELVIS, mapping_for
+from avatarsim.synthesis.movebox.retarget import ROLLS, Retargeting
+from avatarsim.synthesis.movebox.smoothing import (
     TIME_CONSTANT_S,
     ExponentialSmoother,
     absolute,

@@ -8,9 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from avatar_models.errors import MotionFormatError
-from avatar_models.formats import load_motion, save_motion
-from avatar_models.formats.asf_amc import bone_tip_positions, read_asf, read_asf_amc
+from avatarsim.avatar_models.errors import MotionFormatError
+from avatarsim.avatar_models.formats import load_motion, save_motion
+from avatarsim.avatar_models.formats.asf_amc import bone_tip_positions, read_asf, read_asf_amc
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "asf_amc"
 CHAIN_ASF = DATA / "chain.asf"
@@ -220,7 +220,8 @@ def test_malformed_files_name_file_and_line(tmp_path, asf_text, amc_text, messag
 
 
 @pytest.mark.skipif(
-    importlib.util.find_spec("avatar_models.formats.bvh") is None, reason="BVH writer not present"
+    importlib.util.find_spec("avatarsim.avatar_models.formats.bvh") is None,
+    reason="BVH writer not present",
 )
 def test_amc_to_bvh_roundtrip(tmp_path):
     m = load_motion(DATA / "chain.amc", asf=CHAIN_ASF)

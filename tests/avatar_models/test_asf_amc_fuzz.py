@@ -9,9 +9,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from avatar_models.errors import MotionFormatError
-from avatar_models.formats.asf_amc import read_asf_amc
-from avatar_models.motion import Motion
+from avatarsim.avatar_models.errors import MotionFormatError
+from avatarsim.avatar_models.formats.asf_amc import read_asf_amc
+from avatarsim.avatar_models.motion import Motion
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "asf_amc"
 BODY_AMC = "\n".join(

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.body17 import BODY17
-from avatar_models.rigs import load_rig
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.avatar_models.rigs import load_rig
 
 CENTRE = [
     "Bip01",

@@ -5,10 +5,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.body import BodyDescription, BodyError, RestPoseNotUprightError, build_body
-from avatar_models.errors import AvatarsimError
-from avatar_models.rigs import load_rig
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models.body import (
+    BodyDescription,
+    BodyError,
+    RestPoseNotUprightError,
+    build_body,
+)
+from avatarsim.avatar_models.errors import AvatarsimError
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.avatar_models.skeleton import Skeleton
 
 # de Leva (1996) Table 4, male, per body (limbs counted on both sides).
 DE_LEVA = {

@@ -5,16 +5,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.body17 import INDEX
-from avatar_models.body17_angles import (
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.avatar_models.body17_angles import (
     DOF_SLICES,
     HINGES,
     N_DOF,
     angles_from_positions,
     positions_from_angles,
 )
-from avatar_models.generator import generate
-from avatar_models.rigs import body17_positions
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.rigs import body17_positions
 
 
 def test_43_dof_13_ball_joints_and_4_hinges():

@@ -8,8 +8,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from avatar_models.body import build_body, control_spec
-from avatar_models.rigs import load_rig
+from avatarsim.avatar_models.body import build_body, control_spec
+from avatarsim.avatar_models.rigs import load_rig
 
 BODY_LEVEL = ("body_contype", "body_conaffinity")
 """Per-body unions of the geoms' contact bits, which MuJoCo derives when compiling; editing a

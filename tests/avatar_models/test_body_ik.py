@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.body import BodyError, build_body
-from avatar_models.body.ik import HumanoidIK, humanoid_model, motion_from_qpos
-from avatar_models.body17 import BODY17
-from avatar_models.generator import Subject, generate
-from avatar_models.rigs import body17_positions, load_rig
+from avatarsim.avatar_models.body import BodyError, build_body
+from avatarsim.avatar_models.body.ik import HumanoidIK, humanoid_model, motion_from_qpos
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.avatar_models.generator import Subject, generate
+from avatarsim.avatar_models.rigs import body17_positions, load_rig
 
 
 @pytest.fixture(scope="module")

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import quat
-from avatar_models.body import BodyError, build_body
-from avatar_models.motion import Motion
-from avatar_models.rigs import load_rig
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body import BodyError, build_body
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.rigs import load_rig
 
 
 def _posed(rig: str, seed: int) -> Motion:

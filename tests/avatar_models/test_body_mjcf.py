@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
-from avatar_models.body import BodyDescription, BodyError, build_body, hinge_name
-from avatar_models.body17 import BODY17
-from avatar_models.motion import Motion
-from avatar_models.rigs import load_rig
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body import BodyDescription, BodyError, build_body, hinge_name
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.rigs import load_rig
 
 RIGS = ("body17", "avatar", "cmu")
 DATA = Path(__file__).resolve().parents[1] / "data" / "mjcf"
@@ -179,7 +179,7 @@ def test_non_adjacent_segments_collide_adjacent_do_not():
 
 @pytest.mark.mocap
 def test_qpos_replays_real_cmu_mocap_exactly(mocap_dir):
-    from avatar_models.formats import load_motion
+    from avatarsim.avatar_models.formats import load_motion
 
     motion = load_motion(mocap_dir / "cmu" / "09_01.bvh")[::12]
     body = build_body(motion.skeleton)
@@ -216,7 +216,7 @@ def test_toes_are_hinged_bodies_not_colliding_with_their_foot(rig):
 
 
 def test_generated_walk_rolls_over_the_toes_without_sinking_into_the_floor():
-    from avatar_models.generator import generate
+    from avatarsim.avatar_models.generator import generate
 
     motion = generate("walk", duration_s=2.0, fps=60.0)
     body = build_body(motion.skeleton)

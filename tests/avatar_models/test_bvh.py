@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
-from avatar_models.errors import MotionFormatError
-from avatar_models.formats.bvh import read_bvh, write_bvh
-from avatar_models.motion import Motion
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.errors import MotionFormatError
+from avatarsim.avatar_models.formats.bvh import read_bvh, write_bvh
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.skeleton import Skeleton
 
 
 def random_motion(rng: np.random.Generator, n_joints: int = 8, n_frames: int = 5) -> Motion:
@@ -284,7 +284,7 @@ def test_missing_file_is_a_format_error(tmp_path):
 
 @pytest.mark.parametrize("fmt, newline", [("%.6f", "\n"), ("%.10g", "\r\n"), ("%.3e", "\n")])
 def test_fast_and_checked_frame_parsers_agree_bit_for_bit(tmp_path, fmt, newline):
-    from avatar_models.formats.bvh.frames import checked_motion_values, motion_values
+    from avatarsim.avatar_models.formats.bvh.frames import checked_motion_values, motion_values
 
     values = np.random.default_rng(0).normal(scale=100.0, size=(40, 9))
     data = newline.join("\t".join(fmt % v for v in row) for row in values) + newline
@@ -296,7 +296,7 @@ def test_fast_and_checked_frame_parsers_agree_bit_for_bit(tmp_path, fmt, newline
 
 def test_joint_names_with_spaces_round_trip(tmp_path):
     """The avatar rig is a 3ds Max Biped: 'Bip01 L Thigh' must survive write -> read."""
-    from avatar_models.generator import generate
+    from avatarsim.avatar_models.generator import generate
 
     motion = generate("wave", duration_s=0.3, fps=30.0)
     back = read_bvh(write_bvh(motion, tmp_path / "biped.bvh"))

@@ -10,9 +10,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from avatar_models.errors import MotionFormatError
-from avatar_models.formats.bvh import read_bvh, write_bvh
-from avatar_models.motion import Motion
+from avatarsim.avatar_models.errors import MotionFormatError
+from avatarsim.avatar_models.formats.bvh import read_bvh, write_bvh
+from avatarsim.avatar_models.motion import Motion
 from tests.avatar_models.test_bvh import BANDAI_LIKE, TWO_JOINT, random_motion
 
 

@@ -10,10 +10,10 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from avatar_models.config import ConfigError
-from scripts.dataset.budget import check_budget
-from scripts.dataset.config import from_dict
-from scripts.scenario import DEFAULT_SCENARIO, parse_scenario
+from avatarsim.avatar_models.config import ConfigError
+from avatarsim.scripts.dataset.budget import check_budget
+from avatarsim.scripts.dataset.config import from_dict
+from avatarsim.scripts.scenario import DEFAULT_SCENARIO, parse_scenario
 from tests.scripts.dataset.builders import TINY
 
 SCENARIO = tomllib.loads(DEFAULT_SCENARIO.read_text())

@@ -10,7 +10,7 @@ import stat
 import numpy as np
 import pytest
 
-from avatar_models.fileio import (
+from avatarsim.avatar_models.fileio import (
     atomic_file,
     file_mode,
     write_atomic,

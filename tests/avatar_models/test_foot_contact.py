@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.foot_contact import contact_mask, horizontal_speed, lasting
+from avatarsim.avatar_models.foot_contact import contact_mask, horizontal_speed, lasting
 
 
 def test_low_slow_points_are_in_contact():

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.errors import MotionValueError
-from avatar_models.generator import (
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.generator import (
     ACTIVITIES,
     STYLES,
     Subject,

@@ -11,10 +11,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from avatar_models.body import build_body
-from avatar_models.generator import ACTIVITIES, Subject, generate, sample_subject
-from avatar_models.generator.com import MassModel, lipm_centre_of_mass
-from sim.plausibility import check_motion
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.generator import ACTIVITIES, Subject, generate, sample_subject
+from avatarsim.avatar_models.generator.com import MassModel, lipm_centre_of_mass
+from avatarsim.sim.plausibility import check_motion
 
 # The tall, fast walker swings its legs hardest; the small tired boxer turns its arm furthest.
 SUBJECTS = (

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.body17 import INDEX
-from avatar_models.generator import Subject, generate
-from avatar_models.rigs import body17_positions
-from sim.plausibility import check_motion
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.avatar_models.generator import Subject, generate
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.sim.plausibility import check_motion
 
 ACTIVITY = "controllerpose_study"
 FPS = 30.0

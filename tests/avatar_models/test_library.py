@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from avatar_models.errors import MotionValueError
-from avatar_models.library import MotionLibrary, parse_free_form
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.library import MotionLibrary, parse_free_form
 
 DATA = Path(__file__).resolve().parents[1] / "data" / "asf_amc"
 

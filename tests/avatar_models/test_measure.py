@@ -5,11 +5,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import quat
-from avatar_models.measure import bone_lengths_over_time, lowest_point, path_length, standing_height
-from avatar_models.motion import Motion
-from avatar_models.rigs import load_rig
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.measure import (
+    bone_lengths_over_time,
+    lowest_point,
+    path_length,
+    standing_height,
+)
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.avatar_models.skeleton import Skeleton
 
 
 def test_body17_rig_height_within_five_percent():

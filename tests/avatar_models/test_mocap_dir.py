@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import pytest
 
-from avatar_models import AvatarsimError
-from avatar_models.mocap_dir import MOCAP_ENV, mocap_dir
+from avatarsim.avatar_models import AvatarsimError
+from avatarsim.avatar_models.mocap_dir import MOCAP_ENV, mocap_dir
 
 
 def test_option_then_environment_then_none(tmp_path, monkeypatch):

@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation, Slerp
 
-from avatar_models import quat
-from avatar_models.errors import MotionValueError, UnknownJointError
-from avatar_models.motion import Motion, forward_kinematics
-from avatar_models.rigs import load_rig
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.errors import MotionValueError, UnknownJointError
+from avatarsim.avatar_models.motion import Motion, forward_kinematics
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.avatar_models.skeleton import Skeleton
 
 
 def chain_skeleton() -> Skeleton:

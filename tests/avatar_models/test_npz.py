@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.errors import MotionFormatError
-from avatar_models.formats.npz import read_npz, write_npz
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models.errors import MotionFormatError
+from avatarsim.avatar_models.formats.npz import read_npz, write_npz
+from avatarsim.avatar_models.skeleton import Skeleton
 from tests.avatar_models.test_bvh import random_motion
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation, Slerp
 
-from avatar_models import quat
+from avatarsim.avatar_models import quat
 
 
 def test_mul_rotate_conj_match_scipy():

@@ -16,10 +16,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from avatar_models.formats.bvh import read_bvh, write_bvh
-from avatar_models.formats.units import Y_UP_TO_Z_UP
-from avatar_models.measure import bone_lengths_over_time, lowest_point, standing_height
-from avatar_models.rigs import body17_positions, identify_rig
+from avatarsim.avatar_models.formats.bvh import read_bvh, write_bvh
+from avatarsim.avatar_models.formats.units import Y_UP_TO_Z_UP
+from avatarsim.avatar_models.measure import bone_lengths_over_time, lowest_point, standing_height
+from avatarsim.avatar_models.rigs import body17_positions, identify_rig
 from tests.conftest import require_module
 
 pytestmark = pytest.mark.mocap

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.body17 import BODY17
-from avatar_models.errors import RigError
-from avatar_models.rigs import available_rigs, identify_rig, load_rig
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.avatar_models.errors import RigError
+from avatarsim.avatar_models.rigs import available_rigs, identify_rig, load_rig
+from avatarsim.avatar_models.skeleton import Skeleton
 
 RIGS = available_rigs()
 # bandai.toml documents a rest pose that is not upright (bones along local X; the motion stands

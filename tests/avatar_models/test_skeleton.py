@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.errors import MotionValueError, UnknownJointError
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models.errors import MotionValueError, UnknownJointError
+from avatarsim.avatar_models.skeleton import Skeleton
 
 
 def test_mirror_map_pairs_common_naming_schemes():

@@ -41,15 +41,15 @@ from pathlib import Path
 
 import numpy as np
 
-import avatar_models  # noqa: F401  (the headless GL backend, before anything imports mujoco)
-from avatar_models.formats import load_motion
-from avatar_models.generator import generate, sample_subject
-from avatar_models.rigs import load_rig
-from scripts.stages.devices import REALISTIC_NOISE
-from synthesis.avatargo import AvatarGo
-from synthesis.avatargo.study import sample_user, setup_for
-from synthesis.avatargo.walk_in import walk_in
-from synthesis.base import TrackingFrame
+import avatarsim.avatar_models  # noqa: F401  (the headless GL backend, before anything imports mujoco)
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.generator import generate, sample_subject
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.scripts.stages.devices import REALISTIC_NOISE
+from avatarsim.synthesis.avatargo import AvatarGo
+from avatarsim.synthesis.avatargo.study import sample_user, setup_for
+from avatarsim.synthesis.avatargo.walk_in import walk_in
+from avatarsim.synthesis.base import TrackingFrame
 from tests.measurements.coolmoves_step_cost import main, print_step_timing
 
 MOCAP = Path(

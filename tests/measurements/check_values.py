@@ -16,11 +16,11 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.body import build_body
-from avatar_models.formats import load_motion
-from avatar_models.generator import generate, sample_subject
-from sim import corrupt
-from sim.plausibility import check_motion
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.generator import generate, sample_subject
+from avatarsim.sim import corrupt
+from avatarsim.sim.plausibility import check_motion
 
 KEYS = ("jitter_m_s3_median", "skate_cm_s_median", "skate_slide_cm_max")
 BANDAI = (

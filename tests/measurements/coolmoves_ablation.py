@@ -84,17 +84,17 @@ from dataclasses import replace
 
 import numpy as np
 
-from avatar_models import body17
-from avatar_models.measure import standing_height
-from avatar_models.rigs import body17_positions
-from render_cams import VRSetup
-from render_cams.device import motion_at_rate
-from synthesis.coolmoves import CoolMoves
-from synthesis.coolmoves.correlation import pearson
-from synthesis.evaluate import database_for, folds, library_trials
-from synthesis.evaluate.validation import choose_max_distance
-from synthesis.methods import METHODS
-from synthesis.scoring import GROUPS, WARM_UP, score_run
+from avatarsim.avatar_models import body17
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams import VRSetup
+from avatarsim.render_cams.device import motion_at_rate
+from avatarsim.synthesis.coolmoves import CoolMoves
+from avatarsim.synthesis.coolmoves.correlation import pearson
+from avatarsim.synthesis.evaluate import database_for, folds, library_trials
+from avatarsim.synthesis.evaluate.validation import choose_max_distance
+from avatarsim.synthesis.methods import METHODS
+from avatarsim.synthesis.scoring import GROUPS, WARM_UP, score_run
 from tests.measurements import coolmoves_floors as floors
 from tests.measurements import coolmoves_reference as reference
 

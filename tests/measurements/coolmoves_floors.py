@@ -52,13 +52,13 @@ import sys
 import numpy as np
 from scipy.spatial import cKDTree
 
-from avatar_models import Motion, body17
-from avatar_models.rigs import body17_positions
-from render_cams.device import motion_at_rate
-from synthesis.coolmoves import Database
-from synthesis.coolmoves.database import HANDS_DRIVE, driver_positions
-from synthesis.evaluate import database_for, folds, library_trials
-from synthesis.scoring import WARM_UP
+from avatarsim.avatar_models import Motion, body17
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams.device import motion_at_rate
+from avatarsim.synthesis.coolmoves import Database
+from avatarsim.synthesis.coolmoves.database import HANDS_DRIVE, driver_positions
+from avatarsim.synthesis.evaluate import database_for, folds, library_trials
+from avatarsim.synthesis.scoring import WARM_UP
 
 HANDS = body17.group_indices(body17.HANDS)
 HIPS = [body17.BODY17.index(j) for j in ("l_hip", "r_hip")]

@@ -51,10 +51,10 @@ from functools import cache
 
 import numpy as np
 
-from avatar_models.measure import standing_height
-from render_cams import VRSetup
-from synthesis.evaluate import database_for, library_trials
-from synthesis.methods import METHODS
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.render_cams import VRSetup
+from avatarsim.synthesis.evaluate import database_for, library_trials
+from avatarsim.synthesis.methods import METHODS
 from tests.measurements.coolmoves_ablation import variants
 
 SHOWN = ("paper", "no-threshold", "reference w=0.5", "single-pose floor")

@@ -21,16 +21,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import Motion, body17
-from avatar_models.rigs import body17_positions
-from render_cams import TrackingStream
-from synthesis.base import on_clock, usable_mask
-from synthesis.coolmoves import Database
-from synthesis.coolmoves.alignment import alignment_yaw
-from synthesis.coolmoves.blend import inverse_distance_weights
-from synthesis.coolmoves.database import driver_positions
-from synthesis.coolmoves.features import search_vectors, sliding_windows
-from synthesis.coolmoves.knn import K_NEIGHBOURS
+from avatarsim.avatar_models import Motion, body17
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams import TrackingStream
+from avatarsim.synthesis.base import on_clock, usable_mask
+from avatarsim.synthesis.coolmoves import Database
+from avatarsim.synthesis.coolmoves.alignment import alignment_yaw
+from avatarsim.synthesis.coolmoves.blend import inverse_distance_weights
+from avatarsim.synthesis.coolmoves.database import driver_positions
+from avatarsim.synthesis.coolmoves.features import search_vectors, sliding_windows
+from avatarsim.synthesis.coolmoves.knn import K_NEIGHBOURS
 
 ARMS = {
     side: [body17.BODY17.index(f"{side}_{p}") for p in ("shoulder", "elbow", "wrist")]

@@ -50,13 +50,13 @@ from pathlib import Path
 
 import numpy as np
 
-import avatar_models  # noqa: F401  (the headless GL backend, before anything imports mujoco)
-from avatar_models.generator import generate, sample_subject
-from render_cams import VRSetup
-from synthesis.base import TrackingFrame
-from synthesis.coolmoves import build_database
-from synthesis.evaluate import PAPER_ACTIVITIES
-from synthesis.methods import MethodInputs, build
+import avatarsim.avatar_models  # noqa: F401  (the headless GL backend, before anything imports mujoco)
+from avatarsim.avatar_models.generator import generate, sample_subject
+from avatarsim.render_cams import VRSetup
+from avatarsim.synthesis.base import TrackingFrame
+from avatarsim.synthesis.coolmoves import build_database
+from avatarsim.synthesis.evaluate import PAPER_ACTIVITIES
+from avatarsim.synthesis.methods import MethodInputs, build
 
 METHODS = ("coolmoves", "coolmoves+arm-ik")
 MOCAP = Path(
@@ -82,7 +82,7 @@ def bench_input():
 
 def bandai_input():
     """A dataset-2 walk (6 s) and a database of three other takes, or None without mocap."""
-    from avatar_models.library import MotionLibrary
+    from avatarsim.avatar_models.library import MotionLibrary
 
     folder = MOCAP / "bandai" / "dataset-2"
     if not folder.is_dir():

@@ -16,10 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.formats import load_motion
-from synthesis.coolmoves.correlation import CORRELATION_THRESHOLD, hand_foot_correlation
-from synthesis.coolmoves.database import hands_and_feet
-from synthesis.evaluate import builtin_trials
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.synthesis.coolmoves.correlation import CORRELATION_THRESHOLD, hand_foot_correlation
+from avatarsim.synthesis.coolmoves.database import hands_and_feet
+from avatarsim.synthesis.evaluate import builtin_trials
 
 CMU_ACTIVITIES = {
     "06_06": "basketball",

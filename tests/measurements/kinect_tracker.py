@@ -28,22 +28,22 @@ import time
 
 import numpy as np
 
-from avatar_models.body17 import BODY17, MIRROR
-from avatar_models.formats import load_motion
-from avatar_models.generator import generate, sample_subject
-from avatar_models.rigs import body17_positions, load_rig
-from render_cams.device import motion_at_rate
-from render_cams.kinect.device import Kinect
-from render_cams.kinect.parts import N_PARTS
-from render_cams.kinect.placement import default_sensor_pose, performer_target
-from render_cams.kinect.skeleton import TrackingState
-from render_cams.kinect.tracker import DEFAULT_MODEL, load_tracker
-from render_cams.kinect.training import orbit, render_training_frames
-from render_cams.vr import VRSetup
-from sim.humanoid import humanoid_for
-from synthesis.movebox import MoveBox
-from synthesis.movebox.resize import avatar_for
-from synthesis.scoring import score_run
+from avatarsim.avatar_models.body17 import BODY17, MIRROR
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.generator import generate, sample_subject
+from avatarsim.avatar_models.rigs import body17_positions, load_rig
+from avatarsim.render_cams.device import motion_at_rate
+from avatarsim.render_cams.kinect.device import Kinect
+from avatarsim.render_cams.kinect.parts import N_PARTS
+from avatarsim.render_cams.kinect.placement import default_sensor_pose, performer_target
+from avatarsim.render_cams.kinect.skeleton import TrackingState
+from avatarsim.render_cams.kinect.tracker import DEFAULT_MODEL, load_tracker
+from avatarsim.render_cams.kinect.training import orbit, render_training_frames
+from avatarsim.render_cams.vr import VRSetup
+from avatarsim.sim.humanoid import humanoid_for
+from avatarsim.synthesis.movebox import MoveBox
+from avatarsim.synthesis.movebox.resize import avatar_for
+from avatarsim.synthesis.scoring import score_run
 from tests.conftest import MOCAP_DIR
 
 YAWS = {"front": 0.0, "45": 45.0, "side": 90.0, "back": 180.0}
@@ -99,7 +99,7 @@ def parts_scores(tracker, config, quick: bool) -> dict:
 
 
 def tracker_sensor_K(config) -> np.ndarray:
-    from render_cams.kinect.sensors import get_sensor
+    from avatarsim.render_cams.kinect.sensors import get_sensor
 
     return get_sensor(config.sensor).K
 
@@ -181,7 +181,7 @@ def main() -> None:
     quick = "--quick" in sys.argv
     model = args[0] if args else DEFAULT_MODEL
     tracker = load_tracker(model)
-    from render_cams.kinect.training import TrackerTrainingConfig
+    from avatarsim.render_cams.kinect.training import TrackerTrainingConfig
 
     config = TrackerTrainingConfig(
         **{k: tuple(v) if isinstance(v, list) else v for k, v in tracker.meta["config"].items()}

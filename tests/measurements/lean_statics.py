@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.body import build_body
-from avatar_models.generator import generate, sample_subject
-from avatar_models.rigs import load_rig
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.generator import generate, sample_subject
+from avatarsim.avatar_models.rigs import load_rig
 from tests.sim.control.test_qp import ankle_balance
 
 

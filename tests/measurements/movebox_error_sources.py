@@ -53,25 +53,25 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models import Motion
-from avatar_models.formats import load_motion
-from avatar_models.measure import standing_height
-from avatar_models.rigs import body17_positions, load_rig
-from render_cams.device import motion_at_rate
-from render_cams.kinect import TrackingState, kinect_skeleton
-from render_cams.vr import VRSetup
-from scripts.movebox_eval import (
+from avatarsim.avatar_models import Motion
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.rigs import body17_positions, load_rig
+from avatarsim.render_cams.device import motion_at_rate
+from avatarsim.render_cams.kinect import TrackingState, kinect_skeleton
+from avatarsim.render_cams.vr import VRSetup
+from avatarsim.scripts.movebox_eval import (
     body17_err_cm,
     body17_tracked,
     kinect_err_cm,
     retargeted,
     shown_tracked,
 )
-from sim.humanoid import humanoid_for
-from synthesis.base import on_clock
-from synthesis.movebox import MoveBox
-from synthesis.movebox.resize import avatar_for, resized
-from synthesis.scoring import body17_errors_cm
+from avatarsim.sim.humanoid import humanoid_for
+from avatarsim.synthesis.base import on_clock
+from avatarsim.synthesis.movebox import MoveBox
+from avatarsim.synthesis.movebox.resize import avatar_for, resized
+from avatarsim.synthesis.scoring import body17_errors_cm
 
 MAX_S = 8.0
 

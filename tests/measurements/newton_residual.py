@@ -12,8 +12,8 @@ import sys
 
 import numpy as np
 
-from avatar_models.body import build_body
-from avatar_models.rigs import load_rig
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.rigs import load_rig
 from tests.sim.control.test_controller import newton_residual_bw
 
 

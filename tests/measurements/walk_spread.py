@@ -13,10 +13,10 @@ import json
 
 import numpy as np
 
-from avatar_models.body import build_body
-from avatar_models.generator import generate, sample_subject
-from sim.control.controller import control
-from sim.control.model import control_model
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.generator import generate, sample_subject
+from avatarsim.sim.control.controller import control
+from avatarsim.sim.control.model import control_model
 
 
 def main() -> None:

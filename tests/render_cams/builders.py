@@ -7,9 +7,9 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from avatar_models import Motion, quat
-from avatar_models.rigs import load_rig
-from render_cams import TrackingStream
+from avatarsim.avatar_models import Motion, quat
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.render_cams import TrackingStream
 
 
 def body17_motion(fps: float = 90.0, seconds: float = 2.0) -> Motion:

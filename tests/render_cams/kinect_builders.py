@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import Motion
-from avatar_models.generator import Subject, subject_skeleton
+from avatarsim.avatar_models import Motion
+from avatarsim.avatar_models.generator import Subject, subject_skeleton
 
 
 def t_pose(frames: int = 1, fps: float = 30.0, yaw: float = 0.0) -> Motion:

@@ -3,13 +3,13 @@
 import numpy as np
 import pytest
 
-from avatar_models.generator import generate
-from render_cams.device import DeviceError
-from render_cams.fisheye import bad_frames
-from render_cams.fisheye.model import FisheyeModel
-from render_cams.fisheye.render import FisheyeRenderer
-from render_cams.fisheye.rig import camera_poses, controller_cameras
-from render_cams.scene import BodyScene
+from avatarsim.avatar_models.generator import generate
+from avatarsim.render_cams.device import DeviceError
+from avatarsim.render_cams.fisheye import bad_frames
+from avatarsim.render_cams.fisheye.model import FisheyeModel
+from avatarsim.render_cams.fisheye.render import FisheyeRenderer
+from avatarsim.render_cams.fisheye.rig import camera_poses, controller_cameras
+from avatarsim.render_cams.scene import BodyScene
 
 
 @pytest.fixture(scope="module")

@@ -9,20 +9,20 @@ import sys
 import numpy as np
 import pytest
 
-from avatar_models.body17 import BODY17, INDEX
-from avatar_models.generator import generate
-from avatar_models.rigs import body17_positions
-from render_cams.fisheye.blazepose import (
+from avatarsim.avatar_models.body17 import BODY17, INDEX
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams.fisheye.blazepose import (
     BODY17_FROM_BLAZEPOSE,
     BlazePoseDetector,
     body17_from_landmarks,
 )
-from render_cams.fisheye.detector import ErrorModelDetector
-from render_cams.fisheye.pck import mirror_tolerant, pck
-from render_cams.fisheye.pixel_views import pixel_views
-from render_cams.fisheye.pose_detector import DetectorError, PoseDetector
-from render_cams.scene import BodyScene
-from render_cams.third_person import render_third_person
+from avatarsim.render_cams.fisheye.detector import ErrorModelDetector
+from avatarsim.render_cams.fisheye.pck import mirror_tolerant, pck
+from avatarsim.render_cams.fisheye.pixel_views import pixel_views
+from avatarsim.render_cams.fisheye.pose_detector import DetectorError, PoseDetector
+from avatarsim.render_cams.scene import BodyScene
+from avatarsim.render_cams.third_person import render_third_person
 from tests.conftest import require_module
 
 pose_solution = require_module("mediapipe.python.solutions.pose")

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from render_cams.fisheye import calibration
-from render_cams.fisheye.calibration import CalibrationError, calibrate_fisheye
-from render_cams.fisheye.model import FisheyeModel
+from avatarsim.render_cams.fisheye import calibration
+from avatarsim.render_cams.fisheye.calibration import CalibrationError, calibrate_fisheye
+from avatarsim.render_cams.fisheye.model import FisheyeModel
 
 # A paper-sized lens (640x480, 150 x 120 deg) with non-zero Kannala-Brandt coefficients.
 TRUTH = FisheyeModel.from_fov(D=(0.02, -0.01, 0.003, -0.0005))

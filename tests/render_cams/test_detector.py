@@ -5,10 +5,10 @@ import numpy as np
 import pytest
 from scipy.stats import spearmanr
 
-from avatar_models.body17 import BODY17, INDEX
-from render_cams.device import DeviceError
-from render_cams.fisheye.detector import BODY17_SIGMAS, ErrorModelDetector
-from render_cams.fisheye.pose_detector import ViewTruth
+from avatarsim.avatar_models.body17 import BODY17, INDEX
+from avatarsim.render_cams.device import DeviceError
+from avatarsim.render_cams.fisheye.detector import BODY17_SIGMAS, ErrorModelDetector
+from avatarsim.render_cams.fisheye.pose_detector import ViewTruth
 
 N = 20000
 # A person whose keypoints span a 200 x 400 px box: person size sqrt(200 * 400) px.

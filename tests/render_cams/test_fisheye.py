@@ -6,10 +6,10 @@ import pyrender
 import pytest
 import trimesh
 
-from avatar_models.generator import generate
-from render_cams.fisheye.model import FisheyeModel, IntrinsicsError
-from render_cams.fisheye.render import FisheyeRenderer
-from render_cams.scene import BodyScene
+from avatarsim.avatar_models.generator import generate
+from avatarsim.render_cams.fisheye.model import FisheyeModel, IntrinsicsError
+from avatarsim.render_cams.fisheye.render import FisheyeRenderer
+from avatarsim.render_cams.scene import BodyScene
 
 D_TEST = (0.05, 0.01, -0.002, 0.0005)
 

@@ -3,12 +3,16 @@
 import numpy as np
 import pytest
 
-from avatar_models.body import build_body
-from avatar_models.generator import ACTIVITIES, Subject, generate
-from render_cams.device import Device, DeviceError, motion_at_rate
-from render_cams.fisheye.device import FisheyeRig
-from render_cams.fisheye.model import FisheyeModel
-from render_cams.fisheye.rig import camera_poses, check_cameras_outside, controller_cameras
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.generator import ACTIVITIES, Subject, generate
+from avatarsim.render_cams.device import Device, DeviceError, motion_at_rate
+from avatarsim.render_cams.fisheye.device import FisheyeRig
+from avatarsim.render_cams.fisheye.model import FisheyeModel
+from avatarsim.render_cams.fisheye.rig import (
+    camera_poses,
+    check_cameras_outside,
+    controller_cameras,
+)
 
 
 def test_a_rig_is_a_device_that_records_every_camera_in_memory():

@@ -5,10 +5,10 @@ import json
 import cv2
 import numpy as np
 
-from avatar_models.generator import generate
-from render_cams.fisheye.device import FisheyeRig
-from render_cams.fisheye.records import model_from_record
-from render_cams.fisheye.sequence import write_fisheye_recording
+from avatarsim.avatar_models.generator import generate
+from avatarsim.render_cams.fisheye.device import FisheyeRig
+from avatarsim.render_cams.fisheye.records import model_from_record
+from avatarsim.render_cams.fisheye.sequence import write_fisheye_recording
 from tests.render_cams.builders import folder_bytes
 
 

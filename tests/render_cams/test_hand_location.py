@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from avatar_models.body17 import INDEX
-from avatar_models.generator import generate_library
-from render_cams.hand_location import hand_location_study, hand_measures
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.avatar_models.generator import generate_library
+from avatarsim.render_cams.hand_location import hand_location_study, hand_measures
 
 
 def test_analytic_hand_positions():

@@ -3,24 +3,24 @@
 import numpy as np
 import pytest
 
-from avatar_models.body17 import INDEX
-from avatar_models.generator import generate
-from avatar_models.rigs import body17_positions
-from render_cams.fisheye.keypoints import (
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams.fisheye.keypoints import (
     confidence,
     joint_thickness,
     project_joints,
     visibility,
 )
-from render_cams.fisheye.model import FisheyeModel
-from render_cams.fisheye.render import FisheyeRenderer
-from render_cams.fisheye.rig import (
+from avatarsim.render_cams.fisheye.model import FisheyeModel
+from avatarsim.render_cams.fisheye.render import FisheyeRenderer
+from avatarsim.render_cams.fisheye.rig import (
     CameraInsideBodyError,
     camera_poses,
     check_cameras_outside,
     controller_cameras,
 )
-from render_cams.scene import BodyScene
+from avatarsim.render_cams.scene import BodyScene
 
 
 @pytest.fixture(scope="module")

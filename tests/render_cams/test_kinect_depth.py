@@ -8,10 +8,10 @@ import pyrender
 import pytest
 import trimesh
 
-from render_cams.kinect import get_sensor, look_at
-from render_cams.kinect.depth import KinectDepthCamera
-from render_cams.kinect.noise import depth_edge_partner
-from render_cams.scene import BodyScene
+from avatarsim.render_cams.kinect import get_sensor, look_at
+from avatarsim.render_cams.kinect.depth import KinectDepthCamera
+from avatarsim.render_cams.kinect.noise import depth_edge_partner
+from avatarsim.render_cams.scene import BodyScene
 from tests.render_cams.kinect_builders import t_pose
 
 SENSOR = get_sensor("kinect-v2")

@@ -5,11 +5,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from render_cams.device import Device
-from render_cams.kinect.depth import BODY_INDEX_NONE
-from render_cams.kinect.device import Kinect
-from render_cams.kinect.placement import performer_distance
-from render_cams.kinect.sensors import KinectError
+from avatarsim.render_cams.device import Device
+from avatarsim.render_cams.kinect.depth import BODY_INDEX_NONE
+from avatarsim.render_cams.kinect.device import Kinect
+from avatarsim.render_cams.kinect.placement import performer_distance
+from avatarsim.render_cams.kinect.sensors import KinectError
 from tests.render_cams.kinect_builders import t_pose
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from render_cams.kinect.features import BACKGROUND_M, DepthFeatures, body_depth
+from avatarsim.render_cams.kinect.features import BACKGROUND_M, DepthFeatures, body_depth
 
 K = np.array([[300.0, 0.0, 50.0], [0.0, 300.0, 40.0], [0.0, 0.0, 1.0]])
 

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 from sklearn.ensemble import ExtraTreesClassifier
 
-from render_cams.kinect.features import DepthFeatures
-from render_cams.kinect.forest import from_sklearn, load_forest
-from render_cams.kinect.sensors import KinectError
+from avatarsim.render_cams.kinect.features import DepthFeatures
+from avatarsim.render_cams.kinect.forest import from_sklearn, load_forest
+from avatarsim.render_cams.kinect.sensors import KinectError
 
 K = np.array([[200.0, 0.0, 32.0], [0.0, 200.0, 24.0], [0.0, 0.0, 1.0]])
 

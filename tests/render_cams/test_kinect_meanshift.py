@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from render_cams.kinect.meanshift import densest_mode
+from avatarsim.render_cams.kinect.meanshift import densest_mode
 
 
 def clusters(rng: np.random.Generator):

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 from scipy.stats import norm
 
-from avatar_models import AvatarsimError
-from render_cams.device import DeviceError
-from render_cams.kinect import DepthNoiseModel, KinectError, get_sensor
-from render_cams.kinect.noise import incidence_angles
-from render_cams.tracking import UnknownDeviceError
+from avatarsim.avatar_models import AvatarsimError
+from avatarsim.render_cams.device import DeviceError
+from avatarsim.render_cams.kinect import DepthNoiseModel, KinectError, get_sensor
+from avatarsim.render_cams.kinect.noise import incidence_angles
+from avatarsim.render_cams.tracking import UnknownDeviceError
 
 SENSOR = get_sensor("kinect-v2")
 K = SENSOR.K

@@ -12,12 +12,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.body17 import BODY17, INDEX
-from avatar_models.rigs import body17_positions
-from render_cams.kinect.depth import KinectDepthCamera
-from render_cams.kinect.parts import N_PARTS, PART_NONE
-from render_cams.kinect.placement import look_at
-from render_cams.scene import BodyScene
+from avatarsim.avatar_models.body17 import BODY17, INDEX
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams.kinect.depth import KinectDepthCamera
+from avatarsim.render_cams.kinect.parts import N_PARTS, PART_NONE
+from avatarsim.render_cams.kinect.placement import look_at
+from avatarsim.render_cams.scene import BodyScene
 from tests.render_cams.kinect_builders import t_pose
 
 BONES = (

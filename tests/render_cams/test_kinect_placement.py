@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.body17 import INDEX
-from avatar_models.formats import load_motion
-from avatar_models.rigs import body17_positions
-from render_cams.kinect import TrackingState, kinect_skeleton
-from render_cams.kinect.placement import (
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams.kinect import TrackingState, kinect_skeleton
+from avatarsim.render_cams.kinect.placement import (
     DEFAULT_HEIGHT_M,
     KinectPlacementError,
     default_sensor_pose,
@@ -19,7 +19,7 @@ from render_cams.kinect.placement import (
     performer_distance,
     yaw_pitch_pose,
 )
-from render_cams.kinect.sensors import get_sensor
+from avatarsim.render_cams.kinect.sensors import get_sensor
 from tests.render_cams.kinect_builders import t_pose, t_pose_walk
 
 NOT_TRACKED = TrackingState.NOT_TRACKED
@@ -122,7 +122,7 @@ def test_real_takes_stay_tracked_and_in_view(mocap_dir, clip, device):
     stretch (2.9 m for Kinect V2, 2.3 m for Azure NFOV, less the body's own depth) of a path
     towards the sensor is seen whole. The sensor keeps such a stretch in view, every joint
     inside range and view is reported, and a part of the take that fits is tracked whole."""
-    from sim.humanoid import humanoid_for  # the humanoid for a foreign rig (Bandai)
+    from avatarsim.sim.humanoid import humanoid_for  # the humanoid for a foreign rig (Bandai)
 
     humanoid = humanoid_for(load_motion(mocap_dir / clip))
     body, motion = humanoid.body, humanoid.motion

@@ -8,11 +8,11 @@ import cv2
 import numpy as np
 import pytest
 
-from render_cams.kinect import KinectError, TrackingState
-from render_cams.kinect.depth import BODY_INDEX_NONE, read_depth_png
-from render_cams.kinect.device import Kinect
-from render_cams.kinect.placement import performer_distance
-from render_cams.kinect.sequence import read_kinect_skeleton, write_kinect_recording
+from avatarsim.render_cams.kinect import KinectError, TrackingState
+from avatarsim.render_cams.kinect.depth import BODY_INDEX_NONE, read_depth_png
+from avatarsim.render_cams.kinect.device import Kinect
+from avatarsim.render_cams.kinect.placement import performer_distance
+from avatarsim.render_cams.kinect.sequence import read_kinect_skeleton, write_kinect_recording
 from tests.render_cams.builders import folder_bytes
 from tests.render_cams.kinect_builders import t_pose
 

@@ -5,18 +5,18 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import quat
-from avatar_models.generator import generate
-from avatar_models.rigs import body17_positions, load_rig
-from render_cams.device import motion_at_rate
-from render_cams.kinect import (
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.rigs import body17_positions, load_rig
+from avatarsim.render_cams.device import motion_at_rate
+from avatarsim.render_cams.kinect import (
     KinectPlacementError,
     SkeletonNoise,
     TrackingState,
     kinect_skeleton,
     look_at,
 )
-from render_cams.tracking import UnknownDeviceError
+from avatarsim.render_cams.tracking import UnknownDeviceError
 from tests.render_cams.kinect_builders import t_pose
 
 BOXING = generate("box", duration_s=1.0, fps=90.0, seed=4)

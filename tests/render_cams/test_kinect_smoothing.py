@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from render_cams.kinect.sensors import KinectError
-from render_cams.kinect.smoothing import SmoothParameters, smooth_joints
+from avatarsim.render_cams.kinect.sensors import KinectError
+from avatarsim.render_cams.kinect.smoothing import SmoothParameters, smooth_joints
 
 
 def one_joint(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

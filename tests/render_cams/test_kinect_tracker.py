@@ -6,17 +6,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.body17 import MIRROR
-from avatar_models.generator import generate
-from avatar_models.rigs import body17_positions, load_rig
-from render_cams.device import motion_at_rate
-from render_cams.kinect.depth import BODY_INDEX_NONE, DepthFrame
-from render_cams.kinect.device import Kinect
-from render_cams.kinect.placement import default_sensor_pose, performer_target
-from render_cams.kinect.sensors import get_sensor
-from render_cams.kinect.skeleton import TrackingState
-from render_cams.kinect.tracker import load_tracker, track
-from render_cams.kinect.training import TrackerTrainingConfig, orbit, train_tracker
+from avatarsim.avatar_models.body17 import MIRROR
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.rigs import body17_positions, load_rig
+from avatarsim.render_cams.device import motion_at_rate
+from avatarsim.render_cams.kinect.depth import BODY_INDEX_NONE, DepthFrame
+from avatarsim.render_cams.kinect.device import Kinect
+from avatarsim.render_cams.kinect.placement import default_sensor_pose, performer_target
+from avatarsim.render_cams.kinect.sensors import get_sensor
+from avatarsim.render_cams.kinect.skeleton import TrackingState
+from avatarsim.render_cams.kinect.tracker import load_tracker, track
+from avatarsim.render_cams.kinect.training import TrackerTrainingConfig, orbit, train_tracker
 from tests.render_cams.kinect_builders import t_pose
 
 WALK = generate("walk", duration_s=1.0, fps=30.0, seed=100)  # a subject never trained on

@@ -4,23 +4,23 @@ from __future__ import annotations
 
 import pytest
 
-from avatar_models.body import build_body
-from avatar_models.body17 import INDEX
-from avatar_models.rigs import body17_positions, load_rig
-from render_cams.fisheye import occlusion
-from render_cams.fisheye.bad_frames import BLACK_LEVEL
-from render_cams.fisheye.device import FisheyeRig
-from render_cams.fisheye.model import FisheyeModel
-from render_cams.fisheye.render import FisheyeRenderer
-from render_cams.fisheye.rig import (
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.avatar_models.rigs import body17_positions, load_rig
+from avatarsim.render_cams.fisheye import occlusion
+from avatarsim.render_cams.fisheye.bad_frames import BLACK_LEVEL
+from avatarsim.render_cams.fisheye.device import FisheyeRig
+from avatarsim.render_cams.fisheye.model import FisheyeModel
+from avatarsim.render_cams.fisheye.render import FisheyeRenderer
+from avatarsim.render_cams.fisheye.rig import (
     CameraMountError,
     Mount,
     camera_poses,
     controller_cameras,
     inside_body,
 )
-from render_cams.kinect.placement import look_at
-from render_cams.scene import BodyScene, SceneError
+from avatarsim.render_cams.kinect.placement import look_at
+from avatarsim.render_cams.scene import BodyScene, SceneError
 from tests.render_cams.kinect_builders import t_pose
 
 TINY = FisheyeModel.from_fov(width=80, height=60)

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.body17 import INDEX, MIRROR
-from render_cams.fisheye.pck import keypoint_errors, mirror_tolerant, pck
-from render_cams.fisheye.pose_detector import Keypoints2D, ViewTruth
+from avatarsim.avatar_models.body17 import INDEX, MIRROR
+from avatarsim.render_cams.fisheye.pck import keypoint_errors, mirror_tolerant, pck
+from avatarsim.render_cams.fisheye.pose_detector import Keypoints2D, ViewTruth
 
 
 def truth() -> ViewTruth:

@@ -7,19 +7,19 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.body17 import INDEX
-from avatar_models.formats import load_motion
-from avatar_models.generator import generate
-from avatar_models.rigs import body17_positions
-from render_cams.fisheye.detector import ErrorModelDetector
-from render_cams.fisheye.device import FisheyeRig
-from render_cams.fisheye.keypoints import confidence, project_joints
-from render_cams.fisheye.model import FisheyeModel
-from render_cams.fisheye.pose2d import composite_keypoints, controller_pose2d
-from render_cams.fisheye.rig import camera_poses, controller_cameras
-from render_cams.fisheye.stitch import stitch_params
-from render_cams.fisheye.torso_view import CORNER_INDICES, apply_homography
-from sim.humanoid import humanoid_for
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams.fisheye.detector import ErrorModelDetector
+from avatarsim.render_cams.fisheye.device import FisheyeRig
+from avatarsim.render_cams.fisheye.keypoints import confidence, project_joints
+from avatarsim.render_cams.fisheye.model import FisheyeModel
+from avatarsim.render_cams.fisheye.pose2d import composite_keypoints, controller_pose2d
+from avatarsim.render_cams.fisheye.rig import camera_poses, controller_cameras
+from avatarsim.render_cams.fisheye.stitch import stitch_params
+from avatarsim.render_cams.fisheye.torso_view import CORNER_INDICES, apply_homography
+from avatarsim.sim.humanoid import humanoid_for
 
 MODEL = FisheyeModel.from_fov().scaled(0.25)
 EXACT = ErrorModelDetector(error_scale=0.0, miss_rate=0.0, swap_rate=0.0, confidence_noise=0.0)

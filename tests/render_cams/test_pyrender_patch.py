@@ -4,8 +4,12 @@ pyrender; a change is reported by name and version, not as wrong pixels."""
 import pyrender
 import pytest
 
-from render_cams import pyrender_patch
-from render_cams.pyrender_patch import PyrenderPatchError, check_pyrender, missing_private_names
+from avatarsim.render_cams import pyrender_patch
+from avatarsim.render_cams.pyrender_patch import (
+    PyrenderPatchError,
+    check_pyrender,
+    missing_private_names,
+)
 
 
 def test_the_installed_pyrender_has_every_private_name_the_patch_uses():

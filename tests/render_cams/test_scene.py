@@ -6,8 +6,8 @@ import pyrender
 import pytest
 import trimesh
 
-from avatar_models.generator import generate
-from render_cams.scene import BodyScene, SceneError, pinhole_K
+from avatarsim.avatar_models.generator import generate
+from avatarsim.render_cams.scene import BodyScene, SceneError, pinhole_K
 
 # A camera 3 m in front of the origin looking back along -X (OpenCV axes as columns).
 LOOK_BACK = np.stack([[0.0, 1.0, 0.0], [0.0, 0.0, -1.0], [-1.0, 0.0, 0.0]], axis=1)
@@ -130,8 +130,8 @@ def test_bad_intrinsics_raise(scene, K):
 def test_mujoco_still_renders_after_the_last_scene_closes():
     """Closing a scene must not terminate the shared EGL display: MuJoCo's renderer (the
     scenario's pictures, after its cameras) initialises that display once, at import."""
-    from sim.humanoid import humanoid_for
-    from sim.render import render_frames
+    from avatarsim.sim.humanoid import humanoid_for
+    from avatarsim.sim.render import render_frames
 
     motion = generate("wave", duration_s=0.2, fps=30)
     h = humanoid_for(motion)

@@ -7,9 +7,9 @@ import cv2
 import numpy as np
 import pytest
 
-from render_cams.fisheye.model import FisheyeModel
-from render_cams.fisheye.rig import COMPOSITE_VERTICAL_FOV_DEG, controller_cameras
-from render_cams.fisheye.stitch import stitch_params, undistortion_maps
+from avatarsim.render_cams.fisheye.model import FisheyeModel
+from avatarsim.render_cams.fisheye.rig import COMPOSITE_VERTICAL_FOV_DEG, controller_cameras
+from avatarsim.render_cams.fisheye.stitch import stitch_params, undistortion_maps
 
 MODEL = FisheyeModel.from_fov(D=(0.02, -0.01, 0.003, -0.0005))
 

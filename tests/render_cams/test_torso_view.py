@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from avatar_models.body17 import BODY17, INDEX
-from render_cams.fisheye.torso_view import (
+from avatarsim.avatar_models.body17 import BODY17, INDEX
+from avatarsim.render_cams.fisheye.torso_view import (
     TORSO_CORNERS,
     TorsoViewError,
     apply_homography,

@@ -7,8 +7,8 @@ import zipfile
 import numpy as np
 import pytest
 
-from avatar_models import AvatarsimError
-from render_cams import StreamError, StreamFormatError, TrackingStream, UnknownDeviceError
+from avatarsim.avatar_models import AvatarsimError
+from avatarsim.render_cams import StreamError, StreamFormatError, TrackingStream, UnknownDeviceError
 from tests.render_cams.builders import static_stream
 
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import quat
-from render_cams import DeviceError, StreamError, UnknownDeviceError, VRSetup
-from render_cams.vr import (
+from avatarsim.avatar_models import quat
+from avatarsim.render_cams import DeviceError, StreamError, UnknownDeviceError, VRSetup
+from avatarsim.render_cams.vr import (
     Drift,
     Dropouts,
     Latency,

@@ -7,10 +7,10 @@ import importlib.util
 import numpy as np
 import pytest
 
-from avatar_models import Motion, MotionValueError, RigError, Skeleton, quat
-from avatar_models.rigs import available_rigs, load_rig
-from render_cams import FULL_BODY, Device, DeviceError, UnknownDeviceError, VRSetup
-from render_cams.vr import Attachment, OffsetSpread, PositionJitter, nominal_attachment
+from avatarsim.avatar_models import Motion, MotionValueError, RigError, Skeleton, quat
+from avatarsim.avatar_models.rigs import available_rigs, load_rig
+from avatarsim.render_cams import FULL_BODY, Device, DeviceError, UnknownDeviceError, VRSetup
+from avatarsim.render_cams.vr import Attachment, OffsetSpread, PositionJitter, nominal_attachment
 from tests.render_cams.builders import body17_motion, rest_motion
 
 ZERO_OFFSETS = {
@@ -193,10 +193,10 @@ def test_skeleton_without_a_rig_is_rejected():
 
 
 @pytest.mark.skipif(
-    importlib.util.find_spec("avatar_models.generator") is None, reason="no generator yet"
+    importlib.util.find_spec("avatarsim.avatar_models.generator") is None, reason="no generator yet"
 )
 def test_generated_walk_on_the_avatar_rig():
-    from avatar_models.generator import generate
+    from avatarsim.avatar_models.generator import generate
 
     motion = generate("walk", duration_s=3.0, fps=30.0, seed=0)
     offsets = {**ZERO_OFFSETS, "left_foot_tracker": Attachment("l_ankle")}

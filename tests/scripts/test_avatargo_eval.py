@@ -9,10 +9,10 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from avatar_models.formats.bvh import read_bvh
-from scripts.avatargo_eval import run_avatargo_eval
-from scripts.cli import app
-from synthesis.evaluate import Trial
+from avatarsim.avatar_models.formats.bvh import read_bvh
+from avatarsim.scripts.avatargo_eval import run_avatargo_eval
+from avatarsim.scripts.cli import app
+from avatarsim.synthesis.evaluate import Trial
 
 runner = CliRunner()
 

@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from avatar_models.formats import save_motion
-from avatar_models.generator import generate
-from scripts.cli import app
+from avatarsim.avatar_models.formats import save_motion
+from avatarsim.avatar_models.generator import generate
+from avatarsim.scripts.cli import app
 from tests.conftest import require
 
 runner = CliRunner()
@@ -155,7 +155,7 @@ def test_control_replaces_its_own_output_but_not_a_file_added_to_it(tmp_path, cl
 
 @pytest.mark.parametrize("failure", [RuntimeError, KeyboardInterrupt, SystemExit])
 def test_no_partial_folder_is_left_after_a_failure(tmp_path, scenario, monkeypatch, failure):
-    from scripts.stages import physics
+    from avatarsim.scripts.stages import physics
 
     def broken(ctx):
         raise failure("stopped")
@@ -169,7 +169,7 @@ def test_no_partial_folder_is_left_after_a_failure(tmp_path, scenario, monkeypat
 
 
 def test_atomic_dir_cleans_up_and_keeps_the_old_output_when_the_block_fails(tmp_path):
-    from scripts.results import atomic_dir
+    from avatarsim.scripts.results import atomic_dir
 
     out = tmp_path / "o"
     with atomic_dir(out, "control") as partial:
@@ -368,7 +368,7 @@ def test_convert_writes_files_with_the_umask_mode(tmp_path, clip):
 
 # -- the T-pose the cgspeed CMU conversions put before the take ----------------------------
 def test_a_prepended_rest_pose_frame_is_dropped_and_reported(tmp_path):
-    from avatar_models.formats import load_motion
+    from avatarsim.avatar_models.formats import load_motion
 
     walk = generate("walk", duration_s=0.5, fps=120.0)
     rest = walk[:1].replace(local_rot=np.tile([1.0, 0.0, 0.0, 0.0], (1, walk.skeleton.n_joints, 1)))
@@ -389,7 +389,7 @@ def test_a_prepended_rest_pose_frame_is_dropped_and_reported(tmp_path):
 
 @pytest.mark.mocap
 def test_cmu_09_01_loses_its_t_pose_frame_and_its_residual_spike(tmp_path, mocap_dir):
-    from avatar_models.formats import load_motion
+    from avatarsim.avatar_models.formats import load_motion
 
     clip = cmu_09_01(mocap_dir)
     m = load_motion(clip)
@@ -406,8 +406,8 @@ def test_cmu_09_01_loses_its_t_pose_frame_and_its_residual_spike(tmp_path, mocap
 
 
 def test_an_output_from_before_the_marker_is_still_replaced(tmp_path):
-    from avatar_models.errors import AvatarsimError
-    from scripts.results import atomic_dir
+    from avatarsim.avatar_models.errors import AvatarsimError
+    from avatarsim.scripts.results import atomic_dir
 
     out = tmp_path / "t"
     out.mkdir()
@@ -444,7 +444,7 @@ def test_an_output_from_before_the_marker_is_still_replaced(tmp_path):
 def test_a_file_system_refusal_mid_run_exits_2_not_3(tmp_path, monkeypatch):
     import errno
 
-    import avatar_models.formats as formats
+    import avatarsim.avatar_models.formats as formats
 
     def full(motion, path, **options):
         raise OSError(errno.ENOSPC, "No space left on device", str(path))
@@ -454,8 +454,8 @@ def test_a_file_system_refusal_mid_run_exits_2_not_3(tmp_path, monkeypatch):
 
 
 def test_numpy_warnings_never_come_before_the_error_line(tmp_path, monkeypatch):
-    import avatar_models.formats as formats
-    from avatar_models.errors import MotionFormatError
+    import avatarsim.avatar_models.formats as formats
+    from avatarsim.avatar_models.errors import MotionFormatError
 
     def noisy(path, **options):
         with np.errstate(divide="warn"):

@@ -8,11 +8,11 @@ import mujoco
 import numpy as np
 from typer.testing import CliRunner
 
-from avatar_models.formats import save_motion
-from avatar_models.generator import generate
-from scripts.cli import app
-from sim.corrupt import float_body
-from sim.plausibility import CONTRACT_KEYS
+from avatarsim.avatar_models.formats import save_motion
+from avatarsim.avatar_models.generator import generate
+from avatarsim.scripts.cli import app
+from avatarsim.sim.corrupt import float_body
+from avatarsim.sim.plausibility import CONTRACT_KEYS
 
 runner = CliRunner()
 

@@ -6,7 +6,7 @@ import pytest
 import typer.main
 from typer.testing import CliRunner
 
-from scripts.cli import app
+from avatarsim.scripts.cli import app
 
 runner = CliRunner()
 
@@ -83,8 +83,8 @@ def test_unknown_benchmark_exits_2():
 
 
 def test_npz_takes_no_unit_and_directories_are_named(tmp_path):
-    from avatar_models.formats import save_motion
-    from avatar_models.generator import generate
+    from avatarsim.avatar_models.formats import save_motion
+    from avatarsim.avatar_models.generator import generate
 
     npz = save_motion(generate("wave", duration_s=0.2), tmp_path / "w.npz")
     result = runner.invoke(app, ["info", str(npz), "--unit", "cm"])
@@ -94,8 +94,8 @@ def test_npz_takes_no_unit_and_directories_are_named(tmp_path):
 
 
 def test_convert_to_an_unwritable_place_exits_2(tmp_path):
-    from avatar_models.formats import save_motion
-    from avatar_models.generator import generate
+    from avatarsim.avatar_models.formats import save_motion
+    from avatarsim.avatar_models.generator import generate
 
     npz = save_motion(generate("wave", duration_s=0.2), tmp_path / "w.npz")
     blocker = tmp_path / "file"
@@ -114,7 +114,7 @@ def test_threshold_on_a_metric_the_scenario_does_not_produce_exits_2(tmp_path):
 
 
 def test_a_bug_exits_3_not_1(monkeypatch, tmp_path):
-    import avatar_models.formats as formats
+    import avatarsim.avatar_models.formats as formats
 
     def broken(*args, **kwargs):
         raise ZeroDivisionError("boom")

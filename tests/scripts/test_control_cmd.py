@@ -9,9 +9,9 @@ import mujoco
 import numpy as np
 from typer.testing import CliRunner
 
-from avatar_models.formats import save_motion
-from avatar_models.generator import generate
-from scripts.cli import app
+from avatarsim.avatar_models.formats import save_motion
+from avatarsim.avatar_models.generator import generate
+from avatarsim.scripts.cli import app
 
 runner = CliRunner()
 
@@ -62,7 +62,7 @@ def test_a_search_that_gives_up_before_the_end_exits_1_with_the_reason(tmp_path,
     fell never", exit 0)."""
     import dataclasses
 
-    import sim.control.search as control_search
+    import avatarsim.sim.control.search as control_search
 
     real = control_search.search
 

@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.generator import generate
-from scripts.corruption import corrupted
-from scripts.scenario import CORRUPTIONS
+from avatarsim.avatar_models.generator import generate
+from avatarsim.scripts.corruption import corrupted
+from avatarsim.scripts.scenario import CORRUPTIONS
 
 
 @pytest.fixture(scope="module")

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from rich.console import Console
 
-from scripts.pipeline import run_scenario
-from scripts.scenario import DEFAULT_SCENARIO, ReportSpec, load_scenario
+from avatarsim.scripts.pipeline import run_scenario
+from avatarsim.scripts.scenario import DEFAULT_SCENARIO, ReportSpec, load_scenario
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,7 @@ import json
 import pytest
 from typer.testing import CliRunner
 
-from scripts.cli import app
+from avatarsim.scripts.cli import app
 
 runner = CliRunner()
 SMALL = ["--subjects", "2", "--takes", "1", "--duration", "1.5", "--no-ablation"]

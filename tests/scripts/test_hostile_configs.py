@@ -10,9 +10,9 @@ import pytest
 import tomli_w
 from typer.testing import CliRunner
 
-from avatar_models.formats import save_motion
-from avatar_models.generator import generate
-from scripts.cli import app
+from avatarsim.avatar_models.formats import save_motion
+from avatarsim.avatar_models.generator import generate
+from avatarsim.scripts.cli import app
 from tests.scripts.dataset.builders import TINY
 
 runner = CliRunner()

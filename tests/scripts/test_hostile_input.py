@@ -11,12 +11,12 @@ import pytest
 from scipy.io import wavfile
 from typer.testing import CliRunner
 
-from avatar_models.errors import MotionValueError
-from avatar_models.formats import load_motion, save_motion
-from avatar_models.generator import ACTIVITIES, generate
-from avatar_models.motion_bounds import check_physical
-from scripts.cli import app
-from scripts.scenario import DEFAULT_SCENARIO
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.formats import load_motion, save_motion
+from avatarsim.avatar_models.generator import ACTIVITIES, generate
+from avatarsim.avatar_models.motion_bounds import check_physical
+from avatarsim.scripts.cli import app
+from avatarsim.scripts.scenario import DEFAULT_SCENARIO
 
 runner = CliRunner()
 

@@ -9,26 +9,26 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from avatar_models.formats import load_motion
-from avatar_models.generator import Subject, generate
-from render_cams import VRSetup
-from scripts.cli import app
-from scripts.leaderboard import (
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.generator import Subject, generate
+from avatarsim.render_cams import VRSetup
+from avatarsim.scripts.cli import app
+from avatarsim.scripts.leaderboard import (
     COLUMNS,
     run_leaderboard,
     tracked_notes,
     tracked_summary,
     trial_row,
 )
-from scripts.method_score import score_method
-from sim.checks.joint_limits import JointLimitCheck
-from sim.checks.penetration import PenetrationCheck
-from sim.checks.residual import ResidualForceCheck
-from sim.checks.skating import SkatingCheck
-from sim.plausibility import check_humanoid
-from sim.thresholds import CheckConfig
-from synthesis.evaluate import Trial
-from synthesis.methods import METHODS, ready_methods
+from avatarsim.scripts.method_score import score_method
+from avatarsim.sim.checks.joint_limits import JointLimitCheck
+from avatarsim.sim.checks.penetration import PenetrationCheck
+from avatarsim.sim.checks.residual import ResidualForceCheck
+from avatarsim.sim.checks.skating import SkatingCheck
+from avatarsim.sim.plausibility import check_humanoid
+from avatarsim.sim.thresholds import CheckConfig
+from avatarsim.synthesis.evaluate import Trial
+from avatarsim.synthesis.methods import METHODS, ready_methods
 from tests.conftest import require
 from tests.synthesis.conftest import TruthReplay
 
@@ -138,9 +138,9 @@ def test_leaderboard_on_real_clips_of_each_source(mocap_dir, source):
 
 
 def test_a_sensor_without_recorder_is_refused_before_any_work(monkeypatch):
-    from scripts import leaderboard
-    from synthesis.evaluate import EvaluationError
-    from synthesis.methods import Method
+    from avatarsim.scripts import leaderboard
+    from avatarsim.synthesis.evaluate import EvaluationError
+    from avatarsim.synthesis.methods import Method
 
     probe = Method("probe", "reads a sensor", METHODS["ik"].build, sensors=("kinect",))
     monkeypatch.setitem(leaderboard.METHODS, "probe", probe)
@@ -150,10 +150,10 @@ def test_a_sensor_without_recorder_is_refused_before_any_work(monkeypatch):
 
 
 def test_a_method_failing_on_a_trial_leaves_the_others_rows(monkeypatch):
-    from scripts import leaderboard
-    from synthesis.base import SynthesisError
-    from synthesis.evaluate import builtin_trials
-    from synthesis.methods import Method
+    from avatarsim.scripts import leaderboard
+    from avatarsim.synthesis.base import SynthesisError
+    from avatarsim.synthesis.evaluate import builtin_trials
+    from avatarsim.synthesis.methods import Method
 
     def refuse(inputs):
         raise SynthesisError("probe cannot run here")
@@ -167,8 +167,8 @@ def test_a_method_failing_on_a_trial_leaves_the_others_rows(monkeypatch):
 
 
 def test_a_rerun_resumes_saved_folds_and_redoes_changed_ones(tmp_path, monkeypatch):
-    from scripts import leaderboard
-    from synthesis.evaluate import builtin_trials
+    from avatarsim.scripts import leaderboard
+    from avatarsim.synthesis.evaluate import builtin_trials
 
     trials = builtin_trials(("box",), n_subjects=2, n_takes=1, duration_s=1.0, seed=0)
     # Two worker processes, one fold each.

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import pytest
 
-from avatar_models.generator import Subject, generate
-from render_cams import VRSetup
-from scripts.method_score import score_method
-from sim.humanoid import humanoid_for
-from sim.plausibility import check_humanoid
-from sim.thresholds import CheckConfig
+from avatarsim.avatar_models.generator import Subject, generate
+from avatarsim.render_cams import VRSetup
+from avatarsim.scripts.method_score import score_method
+from avatarsim.sim.humanoid import humanoid_for
+from avatarsim.sim.plausibility import check_humanoid
+from avatarsim.sim.thresholds import CheckConfig
 from tests.synthesis.conftest import TruthReplay
 
 

@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from avatar_models.generator import generate
-from avatar_models.rigs import load_rig
-from render_cams.kinect import TrackingState, kinect_skeleton
-from scripts.cli import app
-from scripts.movebox_eval import mean_cm, shown_tracked, summarise
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.render_cams.kinect import TrackingState, kinect_skeleton
+from avatarsim.scripts.cli import app
+from avatarsim.scripts.movebox_eval import mean_cm, shown_tracked, summarise
 from tests.synthesis.movebox.conftest import AUDIO_DIR
 
 runner = CliRunner()

@@ -13,8 +13,8 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from avatar_models.formats import load_motion, save_motion
-from scripts.cli import app
+from avatarsim.avatar_models.formats import load_motion, save_motion
+from avatarsim.scripts.cli import app
 
 runner = CliRunner()
 

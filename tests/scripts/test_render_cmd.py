@@ -8,10 +8,10 @@ import imageio.v3 as iio
 import numpy as np
 from typer.testing import CliRunner
 
-from avatar_models.formats import save_motion
-from avatar_models.generator import generate
-from render_cams.kinect.placement import performer_distance
-from scripts.cli import app
+from avatarsim.avatar_models.formats import save_motion
+from avatarsim.avatar_models.generator import generate
+from avatarsim.render_cams.kinect.placement import performer_distance
+from avatarsim.scripts.cli import app
 
 runner = CliRunner()
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import xml.etree.ElementTree as ET
 
-from scripts.results import ThresholdResult, junit_xml
-from scripts.scenario import Threshold
+from avatarsim.scripts.results import ThresholdResult, junit_xml
+from avatarsim.scripts.scenario import Threshold
 
 
 def test_expected_failure_turns_the_verdict_round():

@@ -6,8 +6,8 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from scripts.results import ThresholdResult, junit_xml
-from scripts.scenario import (
+from avatarsim.scripts.results import ThresholdResult, junit_xml
+from avatarsim.scripts.scenario import (
     DEFAULT_SCENARIO,
     ScenarioError,
     Threshold,
@@ -91,7 +91,7 @@ def test_non_finite_thresholds_are_rejected():
 
 
 def test_control_thresholds_need_the_control_stage():
-    from scripts.pipeline import validate
+    from avatarsim.scripts.pipeline import validate
 
     with pytest.raises(ScenarioError, match="does not produce"):
         validate(parse_scenario({"thresholds": {"control_fell": 0.0}}))
@@ -101,7 +101,7 @@ def test_control_thresholds_need_the_control_stage():
 def test_an_unknown_method_is_rejected_before_the_run():
     # Regression: a typo in [synthesis] methods surfaced only after the motion, body, physics
     # and device stages had run.
-    from scripts.pipeline import validate
+    from avatarsim.scripts.pipeline import validate
 
     with pytest.raises(ScenarioError, match="unknown synthesis method.*nonsense"):
         validate(parse_scenario({"devices": {}, "synthesis": {"methods": ["ik", "nonsense"]}}))

@@ -7,17 +7,17 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
-from avatar_models.body import build_body
-from avatar_models.config import ConfigError
-from avatar_models.generator import generate
-from avatar_models.motion import Motion
-from sim.checks.joint_limits import JointLimitCheck
-from sim.checks.replay import BodyReplay
-from sim.checks.residual import cone_distance
-from sim.checks.skating import contact_runs, slip_velocity
-from sim.plausibility import check_motion
-from sim.thresholds import CheckConfig
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.config import ConfigError
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.sim.checks.joint_limits import JointLimitCheck
+from avatarsim.sim.checks.replay import BodyReplay
+from avatarsim.sim.checks.residual import cone_distance
+from avatarsim.sim.checks.skating import contact_runs, slip_velocity
+from avatarsim.sim.plausibility import check_motion
+from avatarsim.sim.thresholds import CheckConfig
 
 
 @pytest.fixture(scope="module")
@@ -142,7 +142,7 @@ def test_config_from_dict_and_toml(tmp_path):
 def test_support_margin_matches_scipy_convex_hull():
     from scipy.spatial import ConvexHull
 
-    from sim.checks.support import outside_margin
+    from avatarsim.sim.checks.support import outside_margin
 
     rng = np.random.default_rng(3)
     points = rng.uniform(-0.2, 0.2, size=(200, 8, 2))
@@ -157,7 +157,7 @@ def test_support_margin_matches_scipy_convex_hull():
 
 
 def test_support_margin_is_translation_invariant_and_nan_without_support():
-    from sim.checks.support import outside_margin
+    from avatarsim.sim.checks.support import outside_margin
 
     rng = np.random.default_rng(4)
     points = rng.uniform(-0.2, 0.2, size=(50, 16, 2))

@@ -6,15 +6,15 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
-from avatar_models.body import build_body
-from avatar_models.body17 import BODY17
-from avatar_models.formats import load_motion
-from avatar_models.generator import generate
-from avatar_models.motion import Motion
-from avatar_models.rigs import body17_positions
-from sim import corrupt
-from sim.plausibility import check_motion
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.sim import corrupt
+from avatarsim.sim.plausibility import check_motion
 
 DEFECTS = ("penetration", "floating", "joint_limits", "skating", "jitter")
 

@@ -7,9 +7,9 @@ import json
 import mujoco
 import numpy as np
 
-from avatar_models.generator import generate
-from sim.export import MAX_KEYS, export_replay
-from sim.humanoid import humanoid_for
+from avatarsim.avatar_models.generator import generate
+from avatarsim.sim.export import MAX_KEYS, export_replay
+from avatarsim.sim.humanoid import humanoid_for
 
 
 def test_replay_keys_are_the_exported_frames(tmp_path):

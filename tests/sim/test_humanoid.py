@@ -6,14 +6,14 @@ import mujoco
 import numpy as np
 import pytest
 
-from avatar_models.body17 import BODY17
-from avatar_models.errors import MotionValueError
-from avatar_models.formats import load_motion
-from avatar_models.generator import generate
-from avatar_models.measure import standing_height
-from avatar_models.rigs import body17_positions
-from sim.humanoid import humanoid_for
-from sim.replay import replay_kinematic
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.sim.humanoid import humanoid_for
+from avatarsim.sim.replay import replay_kinematic
 
 BANDAI_WALK = "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh"
 

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from avatar_models.formats import load_motion
-from avatar_models.generator import generate
-from sim.plausibility import check_motion
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.generator import generate
+from avatarsim.sim.plausibility import check_motion
 
 KINEMATIC = ("penetration", "floating", "skating", "joint_limits", "self_collision", "jitter")
 

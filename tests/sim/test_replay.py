@@ -6,8 +6,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from avatar_models.errors import MotionValueError
-from sim.replay import replay_kinematic
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.sim.replay import replay_kinematic
 
 XML = """
 <mujoco>

@@ -6,17 +6,17 @@ import mujoco
 import numpy as np
 import pytest
 
-from avatar_models.body import build_body
-from avatar_models.body.ik import HumanoidIK, humanoid_model
-from avatar_models.body17 import BODY17
-from avatar_models.errors import MotionValueError
-from avatar_models.formats import load_motion
-from avatar_models.generator import Subject, generate
-from avatar_models.rigs import body17_positions, load_rig
-from sim.retarget import retarget
-from sim.retarget.feet import SWING_CLEARANCE_M, lift_toes, stance_feet, swinging_feet
-from sim.retarget.sizing import fitted_body
-from sim.soles import box_corners, corner_positions, foot_bodies, sole_boxes
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.body.ik import HumanoidIK, humanoid_model
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.generator import Subject, generate
+from avatarsim.avatar_models.rigs import body17_positions, load_rig
+from avatarsim.sim.retarget import retarget
+from avatarsim.sim.retarget.feet import SWING_CLEARANCE_M, lift_toes, stance_feet, swinging_feet
+from avatarsim.sim.retarget.sizing import fitted_body
+from avatarsim.sim.soles import box_corners, corner_positions, foot_bodies, sole_boxes
 
 BANDAI_WALK = "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh"
 
@@ -58,8 +58,8 @@ def test_joint_limits_hold(mocap_dir):
 
 
 def test_rig_without_body17_is_refused():
-    from avatar_models.motion import Motion
-    from avatar_models.skeleton import Skeleton
+    from avatarsim.avatar_models.motion import Motion
+    from avatarsim.avatar_models.skeleton import Skeleton
 
     sk = Skeleton(["a", "b"], [-1, 0], np.array([[0, 0, 1.0], [0, 0, 0.5]]), name="blob")
     motion = Motion(sk, 30.0, np.zeros((2, 3)), np.tile([1.0, 0, 0, 0], (2, 2, 1)))

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import Motion, Skeleton
-from avatar_models.generator import Subject, generate
-from synthesis.base import FrameBatch, Poses, Synthesizer
-from synthesis.coolmoves import build_database
+from avatarsim.avatar_models import Motion, Skeleton
+from avatarsim.avatar_models.generator import Subject, generate
+from avatarsim.synthesis.base import FrameBatch, Poses, Synthesizer
+from avatarsim.synthesis.coolmoves import build_database
 
 TRAIN_SUBJECTS = (
     Subject(height_m=1.70, tempo=0.95, amplitude=1.05),

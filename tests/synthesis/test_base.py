@@ -7,11 +7,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import Skeleton, quat
-from avatar_models.generator import Subject, generate
-from avatar_models.measure import standing_height
-from render_cams import VRSetup
-from synthesis.base import (
+from avatarsim.avatar_models import Skeleton, quat
+from avatarsim.avatar_models.generator import Subject, generate
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.render_cams import VRSetup
+from avatarsim.synthesis.base import (
     FrameBatch,
     Poses,
     SynthesisError,
@@ -19,7 +19,7 @@ from synthesis.base import (
     TrackingFrame,
     on_clock,
 )
-from synthesis.ik_baseline import IKBaseline
+from avatarsim.synthesis.ik_baseline import IKBaseline
 
 
 @pytest.fixture(scope="module")

@@ -6,17 +6,17 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
-from avatar_models.generator import generate
-from avatar_models.motion import forward_kinematics
-from avatar_models.rigs import identify_rig, load_rig
-from render_cams import VRSetup
-from synthesis.base import TrackingFrame
-from synthesis.coolmoves import CoolMoves, Options, build_database
-from synthesis.coolmoves.accuracy import stance_skating_cm_s
-from synthesis.coolmoves.database import driver_positions
-from synthesis.scoring import body17_errors_cm, hand_correlation
-from synthesis.two_bone import chain_fk, solve
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.motion import forward_kinematics
+from avatarsim.avatar_models.rigs import identify_rig, load_rig
+from avatarsim.render_cams import VRSetup
+from avatarsim.synthesis.base import TrackingFrame
+from avatarsim.synthesis.coolmoves import CoolMoves, Options, build_database
+from avatarsim.synthesis.coolmoves.accuracy import stance_skating_cm_s
+from avatarsim.synthesis.coolmoves.database import driver_positions
+from avatarsim.synthesis.scoring import body17_errors_cm, hand_correlation
+from avatarsim.synthesis.two_bone import chain_fk, solve
 from tests.synthesis.conftest import TEST_SUBJECT
 
 

@@ -8,9 +8,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.generator import Subject, generate
-from synthesis.coolmoves.correlation import hand_foot_correlation, keeps
-from synthesis.coolmoves.database import hands_and_feet
+from avatarsim.avatar_models.generator import Subject, generate
+from avatarsim.synthesis.coolmoves.correlation import hand_foot_correlation, keeps
+from avatarsim.synthesis.coolmoves.database import hands_and_feet
 from tests.conftest import require
 from tests.measurements.hand_foot_correlation import cmu_scores
 

@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.rigs import body17_positions
-from render_cams import VRSetup
-from render_cams.vr import NaNSamples, Occlusion, OutOfOrder
-from synthesis.base import TrackingFrame
-from synthesis.coolmoves import CoolMoves
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams import VRSetup
+from avatarsim.render_cams.vr import NaNSamples, Occlusion, OutOfOrder
+from avatarsim.synthesis.base import TrackingFrame
+from avatarsim.synthesis.coolmoves import CoolMoves
 from tests.synthesis.conftest import TEST_SUBJECT
 
 RETURN_S = 2.0

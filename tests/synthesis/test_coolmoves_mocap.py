@@ -5,15 +5,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.library import MotionLibrary
-from avatar_models.rigs import body17_positions
-from render_cams import VRSetup
-from synthesis.base import TrackingFrame
-from synthesis.coolmoves import CoolMoves, Options, build_database
-from synthesis.coolmoves.applications import style_sub_library
-from synthesis.coolmoves.features import search_vectors, sliding_windows
-from synthesis.coolmoves.knn import KNNMatcher
-from synthesis.scoring import body17_errors_cm
+from avatarsim.avatar_models.library import MotionLibrary
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams import VRSetup
+from avatarsim.synthesis.base import TrackingFrame
+from avatarsim.synthesis.coolmoves import CoolMoves, Options, build_database
+from avatarsim.synthesis.coolmoves.applications import style_sub_library
+from avatarsim.synthesis.coolmoves.features import search_vectors, sliding_windows
+from avatarsim.synthesis.coolmoves.knn import KNNMatcher
+from avatarsim.synthesis.scoring import body17_errors_cm
 
 STYLES = ("exhausted", "youthful")
 

@@ -8,12 +8,16 @@ import pytest
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
-from avatar_models.rigs import load_rig
-from synthesis.coolmoves import correlation
-from synthesis.coolmoves.alignment import alignment_yaw, ramp_weights, turn_about_vertical
-from synthesis.coolmoves.blend import blend_rotations, group_weights, inverse_distance_weights
-from synthesis.coolmoves.features import (
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.synthesis.coolmoves import correlation
+from avatarsim.synthesis.coolmoves.alignment import alignment_yaw, ramp_weights, turn_about_vertical
+from avatarsim.synthesis.coolmoves.blend import (
+    blend_rotations,
+    group_weights,
+    inverse_distance_weights,
+)
+from avatarsim.synthesis.coolmoves.features import (
     RATE_HZ,
     WINDOW_SAMPLES,
     feature_vectors,
@@ -21,9 +25,14 @@ from synthesis.coolmoves.features import (
     speed_windows,
     window_stride,
 )
-from synthesis.coolmoves.knn import K_NEIGHBOURS, BothHandsKNN, KNNMatcher, leaf_ordered_tree
-from synthesis.coolmoves.limits import JointLimits
-from synthesis.coolmoves.smoothing import ewma, ewma_step
+from avatarsim.synthesis.coolmoves.knn import (
+    K_NEIGHBOURS,
+    BothHandsKNN,
+    KNNMatcher,
+    leaf_ordered_tree,
+)
+from avatarsim.synthesis.coolmoves.limits import JointLimits
+from avatarsim.synthesis.coolmoves.smoothing import ewma, ewma_step
 from tests.synthesis.conftest import yaw_matrix
 
 

@@ -6,16 +6,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.generator import generate
-from avatar_models.measure import standing_height
-from avatar_models.rigs import body17_positions
-from render_cams import VRSetup
-from render_cams.vr.noise import PositionJitter
-from synthesis.base import SynthesisError, TrackingFrame
-from synthesis.coolmoves import FEET_DRIVE, CoolMoves, Options, build_database
-from synthesis.coolmoves.applications import exaggerate, hands_as_feet, style_sub_library
-from synthesis.coolmoves.database import driver_positions
-from synthesis.scoring import body17_errors_cm, hand_correlation, score_run
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams import VRSetup
+from avatarsim.render_cams.vr.noise import PositionJitter
+from avatarsim.synthesis.base import SynthesisError, TrackingFrame
+from avatarsim.synthesis.coolmoves import FEET_DRIVE, CoolMoves, Options, build_database
+from avatarsim.synthesis.coolmoves.applications import exaggerate, hands_as_feet, style_sub_library
+from avatarsim.synthesis.coolmoves.database import driver_positions
+from avatarsim.synthesis.scoring import body17_errors_cm, hand_correlation, score_run
 from tests.synthesis.conftest import TEST_SUBJECT
 
 

@@ -6,13 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import body17, quat
-from avatar_models.generator import Subject, generate
-from avatar_models.measure import standing_height
-from avatar_models.rigs import body17_positions
-from render_cams import VRSetup
-from synthesis.base import SynthesisError
-from synthesis.ik_baseline import IKBaseline, Stepper
+from avatarsim.avatar_models import body17, quat
+from avatarsim.avatar_models.generator import Subject, generate
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.render_cams import VRSetup
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.ik_baseline import IKBaseline, Stepper
 from tests.conftest import require
 
 TRACKED = body17.group_indices(("head", "l_wrist", "r_wrist"))
@@ -163,9 +163,9 @@ REAL_CLIPS = {
 @pytest.mark.mocap
 @pytest.mark.parametrize("clip", list(REAL_CLIPS))
 def test_real_clip_of_each_source_stands_and_steps(mocap_dir, clip):
-    from avatar_models.formats import load_motion
-    from synthesis.evaluate import ik_rig_for
-    from synthesis.scoring import score_run
+    from avatarsim.avatar_models.formats import load_motion
+    from avatarsim.synthesis.evaluate import ik_rig_for
+    from avatarsim.synthesis.scoring import score_run
 
     path = mocap_dir / clip
     require(path.is_file(), f"{path} is absent")

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import pytest
 
-from render_cams import VRSetup
-from synthesis.base import SynthesisError
-from synthesis.methods import METHODS, MethodInputs, build
-from synthesis.scoring import hand_correlation
+from avatarsim.render_cams import VRSetup
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.methods import METHODS, MethodInputs, build
+from avatarsim.synthesis.scoring import hand_correlation
 from tests.synthesis.conftest import TEST_SUBJECT
 
 

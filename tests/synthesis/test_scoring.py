@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import Motion
-from avatar_models.generator import Subject, generate
-from render_cams import VRSetup
-from synthesis.base import SynthesisError
-from synthesis.coolmoves import CoolMoves
-from synthesis.scoring import GROUPS, body17_errors_cm, hand_correlation, score_run
+from avatarsim.avatar_models import Motion
+from avatarsim.avatar_models.generator import Subject, generate
+from avatarsim.render_cams import VRSetup
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.coolmoves import CoolMoves
+from avatarsim.synthesis.scoring import GROUPS, body17_errors_cm, hand_correlation, score_run
 from tests.synthesis.conftest import TEST_SUBJECT, TruthReplay
 
 

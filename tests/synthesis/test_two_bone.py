@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import quat
-from synthesis.two_bone import unit, unit_arc
+from avatarsim.avatar_models import quat
+from avatarsim.synthesis.two_bone import unit, unit_arc
 
 
 def test_unit_gives_directions_and_lengths():

@@ -37,14 +37,14 @@ radians, i.e. about the axes of bone ``b``'s frame ``C``, not of the Z-up world;
 the Z-up rest frame (the columns of ``K C``) are in ``motion.meta["limit_axes"][b]``.
 """
 
-from avatar_models.formats.asf_amc.amc import (
+from avatarsim.avatar_models.formats.asf_amc.amc import (
     CMU_FPS,
     bone_tip_positions,
     find_asf,
     read_amc_channels,
     read_asf_amc,
 )
-from avatar_models.formats.asf_amc.asf import Asf, AsfBone, asf_skeleton, read_asf
+from avatarsim.avatar_models.formats.asf_amc.asf import Asf, AsfBone, asf_skeleton, read_asf
 
 __all__ = [
     "CMU_FPS",

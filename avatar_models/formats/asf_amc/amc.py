@@ -9,11 +9,11 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
-from avatar_models.errors import MotionFormatError, MotionValueError
-from avatar_models.formats.asf_amc.asf import Asf, asf_skeleton, parse_floats, read_asf
-from avatar_models.formats.units import Y_UP_TO_Z_UP
-from avatar_models.motion import Motion
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.errors import MotionFormatError, MotionValueError
+from avatarsim.avatar_models.formats.asf_amc.asf import Asf, asf_skeleton, parse_floats, read_asf
+from avatarsim.avatar_models.formats.units import Y_UP_TO_Z_UP
+from avatarsim.avatar_models.motion import Motion
 
 CMU_FPS = 120.0  # the CMU database is captured at 120 Hz; AMC files do not say.
 _AMC_KEYWORDS = (":fully-specified", ":degrees", ":radians")

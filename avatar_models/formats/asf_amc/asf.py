@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from avatar_models.errors import MotionFormatError, MotionValueError
-from avatar_models.formats.units import UNITS, Y_UP_TO_Z_UP, unit_scale
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models.errors import MotionFormatError, MotionValueError
+from avatarsim.avatar_models.formats.units import UNITS, Y_UP_TO_Z_UP, unit_scale
+from avatarsim.avatar_models.skeleton import Skeleton
 
 _SECTIONS = (":version", ":name", ":units", ":documentation", ":root", ":bonedata", ":hierarchy")
 _REQUIRED = (":units", ":root", ":bonedata", ":hierarchy")

@@ -34,7 +34,7 @@ is what makes reading fast. Every malformed input raises :class:`MotionFormatErr
 the file and line.
 """
 
-from avatar_models.formats.bvh.reader import prepended_rest_frame, read_bvh
-from avatar_models.formats.bvh.writer import write_bvh
+from avatarsim.avatar_models.formats.bvh.reader import prepended_rest_frame, read_bvh
+from avatarsim.avatar_models.formats.bvh.writer import write_bvh
 
 __all__ = ["prepended_rest_frame", "read_bvh", "write_bvh"]

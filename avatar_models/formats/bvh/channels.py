@@ -7,9 +7,9 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models import quat
-from avatar_models.errors import MotionFormatError
-from avatar_models.formats.bvh.hierarchy import CHANNELS, BvhJoint
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.errors import MotionFormatError
+from avatarsim.avatar_models.formats.bvh.hierarchy import CHANNELS, BvhJoint
 
 # Position channels whose peak-to-peak is below this fraction of their magnitude are constant
 # (files print about 6 significant digits, so "constant" values jitter in the last digit).

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.errors import MotionFormatError
-from avatar_models.motion import FPS_RANGE
+from avatarsim.avatar_models.errors import MotionFormatError
+from avatarsim.avatar_models.motion import FPS_RANGE
 
 # Bytes of frame data that the np.loadtxt fast path reads exactly as the checked path does.
 _DECIMAL_BYTES = b"0123456789.+-eE \t\r\n"

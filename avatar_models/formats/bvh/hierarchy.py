@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.errors import MotionFormatError
+from avatarsim.avatar_models.errors import MotionFormatError
 
 CHANNELS = {f"{a}{kind}": (kind, a) for a in "XYZ" for kind in ("position", "rotation")}
 """BVH channel name -> (``"position"`` | ``"rotation"``, axis letter)."""

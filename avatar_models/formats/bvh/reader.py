@@ -7,14 +7,14 @@ from pathlib import Path
 
 import numpy as np
 
-from avatar_models.errors import MotionFormatError, MotionValueError
-from avatar_models.formats.bvh.channels import root_and_offsets, split_channels
-from avatar_models.formats.bvh.frames import motion_header, motion_values
-from avatar_models.formats.bvh.hierarchy import parse_hierarchy
-from avatar_models.formats.units import Y_UP_TO_Z_UP, detect_unit, unit_scale
-from avatar_models.measure import standing_height
-from avatar_models.motion import Motion
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models.errors import MotionFormatError, MotionValueError
+from avatarsim.avatar_models.formats.bvh.channels import root_and_offsets, split_channels
+from avatarsim.avatar_models.formats.bvh.frames import motion_header, motion_values
+from avatarsim.avatar_models.formats.bvh.hierarchy import parse_hierarchy
+from avatarsim.avatar_models.formats.units import Y_UP_TO_Z_UP, detect_unit, unit_scale
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.skeleton import Skeleton
 
 _MOTION_LINE = re.compile(r"^[ \t]*MOTION[ \t\r]*$", re.MULTILINE)
 # A whole-body turn rate (rad/s, mean over the joints) no person reaches: the joints of a

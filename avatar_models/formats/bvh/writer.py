@@ -8,12 +8,12 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
-from avatar_models.errors import MotionValueError
-from avatar_models.fileio import atomic_file
-from avatar_models.formats.units import Y_UP_TO_Z_UP, unit_scale
-from avatar_models.motion import Motion
-from avatar_models.skeleton import Skeleton
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.fileio import atomic_file
+from avatarsim.avatar_models.formats.units import Y_UP_TO_Z_UP, unit_scale
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.skeleton import Skeleton
 
 
 def _depth_first(skeleton: Skeleton) -> list[int]:

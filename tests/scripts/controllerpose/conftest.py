@@ -6,9 +6,9 @@ from __future__ import annotations
 import pytest
 from typer.testing import CliRunner
 
-from scripts.cli import app
-from scripts.dataset.config import load_config
-from scripts.dataset.runner import generate
+from avatarsim.scripts.cli import app
+from avatarsim.scripts.dataset.config import load_config
+from avatarsim.scripts.dataset.runner import generate
 from tests.scripts.dataset.builders import write_config
 
 VR_AND_FISHEYE = [{"name": "vf", "physics": False}]

@@ -9,8 +9,8 @@ import numpy as np
 import torch
 from typer.testing import CliRunner
 
-from scripts.cli import app
-from synthesis.controllerpose.checkpoint import load
+from avatarsim.scripts.cli import app
+from avatarsim.synthesis.controllerpose.checkpoint import load
 from tests.scripts.controllerpose.conftest import tiny_dataset
 
 runner = CliRunner()
@@ -77,7 +77,7 @@ def test_a_checkpoint_of_another_feature_layout_exits_2(cp_run, cp_dataset, tmp_
 
 
 def test_nan_in_the_features_exits_2(cp_dataset, tmp_path, monkeypatch):
-    import scripts.controllerpose.training as training
+    import avatarsim.scripts.controllerpose.training as training
 
     real = training.load_examples
 
@@ -110,7 +110,7 @@ def test_an_occupied_out_that_holds_no_run_exits_2(cp_dataset, tmp_path):
 def test_the_shipped_scenario_without_a_model_exits_2_before_any_stage(tmp_path, monkeypatch):
     from pathlib import Path
 
-    from synthesis.controllerpose.synthesizer import MODEL_ENV
+    from avatarsim.synthesis.controllerpose.synthesizer import MODEL_ENV
 
     scenario = Path(__file__).resolve().parents[3] / "scripts/scenarios/methods/controllerpose.toml"
     monkeypatch.setenv(MODEL_ENV, str(tmp_path / "no-model"))

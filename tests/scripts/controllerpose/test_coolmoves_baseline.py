@@ -7,11 +7,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.body17 import INDEX
-from scripts.controllerpose.coolmoves_baseline import coolmoves_positions, training_motions
-from scripts.controllerpose.data import load_examples, mocap_examples, split_streams
-from scripts.dataset.torch_dataset import ShardDataset
-from synthesis.coolmoves import build_database
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.scripts.controllerpose.coolmoves_baseline import (
+    coolmoves_positions,
+    training_motions,
+)
+from avatarsim.scripts.controllerpose.data import load_examples, mocap_examples, split_streams
+from avatarsim.scripts.dataset.torch_dataset import ShardDataset
+from avatarsim.synthesis.coolmoves import build_database
 
 SOURCES = {"cmu": "cmu", "bandai-1": "bandai/dataset-1", "bandai-2": "bandai/dataset-2"}
 

@@ -7,15 +7,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.formats.bvh import read_bvh
-from avatar_models.measure import standing_height
-from render_cams.vr import HEADSET_AND_CONTROLLERS, VRSetup
-from scripts.controllerpose.recording import keypoint_recording
-from scripts.stages.devices import REALISTIC_NOISE
-from sim.humanoid import humanoid_for
-from synthesis.base import on_clock
-from synthesis.controllerpose.synthesizer import MODEL_ENV
-from synthesis.methods import MethodInputs, build
+from avatarsim.avatar_models.formats.bvh import read_bvh
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.render_cams.vr import HEADSET_AND_CONTROLLERS, VRSetup
+from avatarsim.scripts.controllerpose.recording import keypoint_recording
+from avatarsim.scripts.stages.devices import REALISTIC_NOISE
+from avatarsim.sim.humanoid import humanoid_for
+from avatarsim.synthesis.base import on_clock
+from avatarsim.synthesis.controllerpose.synthesizer import MODEL_ENV
+from avatarsim.synthesis.methods import MethodInputs, build
 
 CLIPS = {
     "cmu": "cmu/09_01.bvh",
@@ -49,8 +49,8 @@ def test_controllerpose_runs_on_a_real_clip(source, mocap_dir, cp_run, monkeypat
 
 
 def test_without_the_cameras_the_method_says_which_device_to_enable(monkeypatch):
-    from avatar_models.generator import generate
-    from synthesis.base import SynthesisError
+    from avatarsim.avatar_models.generator import generate
+    from avatarsim.synthesis.base import SynthesisError
 
     rig = generate("walk", duration_s=0.2, fps=30.0).skeleton
     inputs = MethodInputs(database_factory=list, user_height_m=1.75, rig=rig)

@@ -2,9 +2,9 @@
 
 import numpy as np
 
-from avatar_models.generator import generate
-from scripts.controllerpose.recording import keypoint_recording
-from sim.humanoid import humanoid_for
+from avatarsim.avatar_models.generator import generate
+from avatarsim.scripts.controllerpose.recording import keypoint_recording
+from avatarsim.sim.humanoid import humanoid_for
 
 
 def test_keypoints_of_a_builtin_wave_are_on_a_30_hz_clock_and_seeded():

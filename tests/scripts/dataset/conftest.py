@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import pytest
 
-from scripts.dataset.config import load_config
-from scripts.dataset.runner import generate
+from avatarsim.scripts.dataset.config import load_config
+from avatarsim.scripts.dataset.runner import generate
 from tests.conftest import require_module
 from tests.scripts.dataset.builders import write_config
 

@@ -4,7 +4,7 @@ from dataclasses import field, fields, make_dataclass, replace
 
 import pytest
 
-from scripts.dataset.config import (
+from avatarsim.scripts.dataset.config import (
     ConfigError,
     DeviceSetConfig,
     config_hash,

@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from avatar_models.errors import AvatarsimError
-from scripts.cli import app
-from scripts.dataset.shards import read_samples, shard_bytes
-from scripts.dataset.torch_dataset import ShardDataset
+from avatarsim.avatar_models.errors import AvatarsimError
+from avatarsim.scripts.cli import app
+from avatarsim.scripts.dataset.shards import read_samples, shard_bytes
+from avatarsim.scripts.dataset.torch_dataset import ShardDataset
 
 runner = CliRunner()
 

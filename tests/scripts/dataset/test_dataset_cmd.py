@@ -8,8 +8,8 @@ import shutil
 import pytest
 from typer.testing import CliRunner
 
-from scripts.cli import app
-from scripts.dataset import runner as runner_module
+from avatarsim.scripts.cli import app
+from avatarsim.scripts.dataset import runner as runner_module
 from tests.scripts.dataset.builders import tree_bytes, write_config
 
 runner = CliRunner()

@@ -7,7 +7,7 @@ import time
 from multiprocessing import active_children
 from pathlib import Path
 
-from scripts.dataset.executors import run
+from avatarsim.scripts.dataset.executors import run
 
 SLOW_ITEM_S = 8.0
 """Far longer than shutting a pool down takes."""

@@ -4,8 +4,8 @@ from collections import Counter
 
 import pytest
 
-from scripts.dataset.config import ConfigError, from_dict
-from scripts.dataset.plan import assign_splits, plan_samples, plan_shards
+from avatarsim.scripts.dataset.config import ConfigError, from_dict
+from avatarsim.scripts.dataset.plan import assign_splits, plan_samples, plan_shards
 from tests.scripts.dataset.builders import TINY
 
 

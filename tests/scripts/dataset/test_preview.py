@@ -6,12 +6,12 @@ import numpy as np
 from PIL import Image
 from typer.testing import CliRunner
 
-from scripts.cli import app
-from scripts.dataset.config import load_config
-from scripts.dataset.manifest import read_manifest
-from scripts.dataset.preview import SKELETON_LINES, preview_sheet, skeleton_pixels
-from scripts.dataset.runner import generate
-from scripts.dataset.shards import read_samples
+from avatarsim.scripts.cli import app
+from avatarsim.scripts.dataset.config import load_config
+from avatarsim.scripts.dataset.manifest import read_manifest
+from avatarsim.scripts.dataset.preview import SKELETON_LINES, preview_sheet, skeleton_pixels
+from avatarsim.scripts.dataset.runner import generate
+from avatarsim.scripts.dataset.shards import read_samples
 from tests.scripts.dataset.builders import write_config
 
 runner = CliRunner()

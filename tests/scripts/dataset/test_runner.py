@@ -11,13 +11,13 @@ from pathlib import Path
 
 import pytest
 
-from scripts.dataset import runner as runner_module
-from scripts.dataset.config import load_config
-from scripts.dataset.executors import ExecutorError
-from scripts.dataset.manifest import DatasetError
-from scripts.dataset.runner import generate
-from scripts.dataset.shards import read_samples
-from scripts.dataset.verify import verify_dataset
+from avatarsim.scripts.dataset import runner as runner_module
+from avatarsim.scripts.dataset.config import load_config
+from avatarsim.scripts.dataset.executors import ExecutorError
+from avatarsim.scripts.dataset.manifest import DatasetError
+from avatarsim.scripts.dataset.runner import generate
+from avatarsim.scripts.dataset.shards import read_samples
+from avatarsim.scripts.dataset.verify import verify_dataset
 from tests.scripts.dataset.builders import TINY, tree_bytes, write_config
 
 REPO = Path(__file__).resolve().parents[3]
@@ -101,7 +101,7 @@ def _generate_cmd(config: Path, out: Path) -> list[str]:
     return [
         sys.executable,
         "-m",
-        "scripts.cli",
+        "avatarsim.scripts.cli",
         "dataset",
         "generate",
         str(config),

@@ -5,15 +5,15 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from avatar_models.body17 import INDEX
-from avatar_models.generator import Subject, generate
-from avatar_models.rigs import body17_positions
-from scripts.dataset.channels import kinect_channel, physics_channel
-from scripts.dataset.config import config_hash, from_dict
-from scripts.dataset.plan import plan_samples
-from scripts.dataset.sample import make_sample
-from scripts.dataset.shards import read_samples, shard_bytes
-from sim.humanoid import humanoid_for
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.avatar_models.generator import Subject, generate
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.scripts.dataset.channels import kinect_channel, physics_channel
+from avatarsim.scripts.dataset.config import config_hash, from_dict
+from avatarsim.scripts.dataset.plan import plan_samples
+from avatarsim.scripts.dataset.sample import make_sample
+from avatarsim.scripts.dataset.shards import read_samples, shard_bytes
+from avatarsim.sim.humanoid import humanoid_for
 from tests.scripts.dataset.builders import TINY
 
 
@@ -182,7 +182,7 @@ def _same(a, b) -> bool:
 def test_body17_angles_label_reproduces_the_keypoints(first_sample):
     """The 43-DoF label channel (ControllerPose §4.3) gives back the body17 keypoints by FK
     (float32 storage: within 1 mm)."""
-    from avatar_models.body17_angles import angles_from_positions, positions_from_angles
+    from avatarsim.avatar_models.body17_angles import angles_from_positions, positions_from_angles
 
     _, arrays, _ = first_sample
     body17 = arrays["body17"].astype(np.float64)

@@ -5,7 +5,7 @@ import tarfile
 
 import numpy as np
 
-from scripts.dataset.shards import read_samples, shard_bytes
+from avatarsim.scripts.dataset.shards import read_samples, shard_bytes
 
 
 def _samples():

@@ -3,9 +3,9 @@ from __future__ import annotations
 import torch
 from torch.utils.data import DataLoader
 
-from scripts.dataset.manifest import read_manifest
-from scripts.dataset.shards import read_samples
-from scripts.dataset.torch_dataset import ShardDataset
+from avatarsim.scripts.dataset.manifest import read_manifest
+from avatarsim.scripts.dataset.shards import read_samples
+from avatarsim.scripts.dataset.torch_dataset import ShardDataset
 
 
 def _keys(loader):

@@ -5,10 +5,10 @@ import shutil
 
 import pytest
 
-from avatar_models.fileio import sha256_file
-from scripts.dataset.manifest import DatasetError
-from scripts.dataset.shards import read_samples, shard_bytes
-from scripts.dataset.verify import verify_dataset
+from avatarsim.avatar_models.fileio import sha256_file
+from avatarsim.scripts.dataset.manifest import DatasetError
+from avatarsim.scripts.dataset.shards import read_samples, shard_bytes
+from avatarsim.scripts.dataset.verify import verify_dataset
 
 
 @pytest.fixture

@@ -10,9 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from scripts.dataset.config import load_config
-from scripts.dataset.runner import generate
-from scripts.dataset.shards import decode_entry, read_samples
+from avatarsim.scripts.dataset.config import load_config
+from avatarsim.scripts.dataset.runner import generate
+from avatarsim.scripts.dataset.shards import decode_entry, read_samples
 from tests.conftest import require_module
 from tests.scripts.dataset.builders import write_config
 

@@ -8,10 +8,10 @@ from types import SimpleNamespace
 
 import pytest
 
-from render_cams.vr.dropouts import Dropouts
-from render_cams.vr.noise import Latency, PositionJitter
-from scripts.scenario import DevicesSpec
-from scripts.stages.devices import REALISTIC_NOISE, metrics_for, setup
+from avatarsim.render_cams.vr.dropouts import Dropouts
+from avatarsim.render_cams.vr.noise import Latency, PositionJitter
+from avatarsim.scripts.scenario import DevicesSpec
+from avatarsim.scripts.stages.devices import REALISTIC_NOISE, metrics_for, setup
 
 
 def vr_for(**spec):
@@ -59,7 +59,7 @@ def test_run_with_avatargo_on_a_real_clip(tmp_path, mocap_dir, source):
     avatar follows the user within the measured bound."""
     from typer.testing import CliRunner
 
-    from scripts.cli import app
+    from avatarsim.scripts.cli import app
 
     clip, bound = REAL_CLIPS[source]
     scenario = tmp_path / "s.toml"

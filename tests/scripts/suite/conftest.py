@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from scripts.cli import app
+from avatarsim.scripts.cli import app
 
 
 def write_scenario(

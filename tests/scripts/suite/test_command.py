@@ -11,11 +11,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import scripts.stages.synthesis as synthesis_stage
-import scripts.suite.runner as runner
-from scripts.scenario import load_scenario
-from scripts.suite.identity import scenario_hash
-from sim import corrupt
+import avatarsim.scripts.stages.synthesis as synthesis_stage
+import avatarsim.scripts.suite.runner as runner
+from avatarsim.scripts.scenario import load_scenario
+from avatarsim.scripts.suite.identity import scenario_hash
+from avatarsim.sim import corrupt
 from tests.conftest import require_module
 from tests.scripts.suite.conftest import invoke, write_scenario
 

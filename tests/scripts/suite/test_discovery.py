@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from scripts.scenario import ScenarioError
-from scripts.suite.discovery import load_suite, scenario_files, selected
+from avatarsim.scripts.scenario import ScenarioError
+from avatarsim.scripts.suite.discovery import load_suite, scenario_files, selected
 from tests.scripts.suite.conftest import write_scenario
 
 SHIPPED = Path(__file__).resolve().parents[3] / "scripts" / "scenarios"

@@ -5,8 +5,8 @@ from __future__ import annotations
 import dataclasses
 import shutil
 
-from scripts.scenario import Threshold, load_scenario
-from scripts.suite.identity import scenario_hash
+from avatarsim.scripts.scenario import Threshold, load_scenario
+from avatarsim.scripts.suite.identity import scenario_hash
 from tests.scripts.suite.conftest import write_scenario
 
 

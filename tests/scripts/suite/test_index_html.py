@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from html.parser import HTMLParser
 
-from scripts.suite.index_html import render_index
+from avatarsim.scripts.suite.index_html import render_index
 
 
 class Cells(HTMLParser):

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from scripts.suite.junit import check_message, metric_unit, suite_junit
+from avatarsim.scripts.suite.junit import check_message, metric_unit, suite_junit
 from tests.conftest import require_module
 
 XSD = Path(__file__).resolve().parents[2] / "data" / "jenkins-junit.xsd"

@@ -6,9 +6,9 @@ import json
 
 import pytest
 
-from scripts.scenario import ScenarioError, load_scenario
-from scripts.suite.identity import scenario_hash
-from scripts.suite.regression import (
+from avatarsim.scripts.scenario import ScenarioError, load_scenario
+from avatarsim.scripts.suite.identity import scenario_hash
+from avatarsim.scripts.suite.regression import (
     BaselineEntry,
     baseline_file,
     check_baseline,

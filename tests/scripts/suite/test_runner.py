@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import json
 
-import scripts.suite.runner as runner
-from scripts.suite.discovery import load_suite
-from scripts.suite.regression import metric_kind
+import avatarsim.scripts.suite.runner as runner
+from avatarsim.scripts.suite.discovery import load_suite
+from avatarsim.scripts.suite.regression import metric_kind
 from tests.scripts.suite.conftest import write_scenario
 
 

@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.body import build_body
-from avatar_models.rigs import load_rig
-from sim.control.balance import clock_rate, reference_stance, step_shift, swing_weights
-from sim.control.controller import control
-from sim.control.model import control_model
-from sim.control.settings import ControlSettings
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.sim.control.balance import clock_rate, reference_stance, step_shift, swing_weights
+from avatarsim.sim.control.controller import control
+from avatarsim.sim.control.model import control_model
+from avatarsim.sim.control.settings import ControlSettings
 
 
 @pytest.fixture(scope="module")

@@ -8,13 +8,13 @@ import mujoco
 import numpy as np
 import pytest
 
-from avatar_models.body import build_body
-from avatar_models.errors import MotionValueError
-from avatar_models.generator import generate, sample_subject
-from avatar_models.rigs import load_rig
-from sim.control.controller import Controller, ControlResult, control
-from sim.control.model import control_model
-from sim.control.settings import ControlSettings
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.generator import generate, sample_subject
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.sim.control.controller import Controller, ControlResult, control
+from avatarsim.sim.control.model import control_model
+from avatarsim.sim.control.settings import ControlSettings
 
 BANDAI_WALK = "bandai/dataset-1/data/dataset-1_walk_normal_001.bvh"
 

@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.body import build_body
-from avatar_models.rigs import load_rig
-from sim.control.controller import control
-from sim.control.falls import HEAD, fallen, first_fall, tilt_deg
-from sim.control.model import control_model
-from sim.control.settings import ControlSettings
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.sim.control.controller import control
+from avatarsim.sim.control.falls import HEAD, fallen, first_fall, tilt_deg
+from avatarsim.sim.control.model import control_model
+from avatarsim.sim.control.settings import ControlSettings
 
 UPRIGHT = np.array([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0])
 

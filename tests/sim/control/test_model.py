@@ -7,11 +7,11 @@ import mujoco
 import numpy as np
 import pytest
 
-from avatar_models.body import build_body
-from avatar_models.errors import MotionValueError
-from avatar_models.rigs import load_rig
-from sim.control.controller import Controller
-from sim.control.model import BodyIndices, control_model, is_control_model
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.sim.control.controller import Controller
+from avatarsim.sim.control.model import BodyIndices, control_model, is_control_model
 
 
 @pytest.fixture(scope="module")

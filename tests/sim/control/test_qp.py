@@ -8,14 +8,14 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
-from avatar_models.body import build_body
-from avatar_models.generator import generate, sample_subject
-from avatar_models.motion import Motion
-from avatar_models.rigs import load_rig
-from sim.control.controller import Controller, ControlResult, control
-from sim.control.model import control_model
-from sim.soles import foot_bodies
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.generator import generate, sample_subject
+from avatarsim.avatar_models.motion import Motion
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.sim.control.controller import Controller, ControlResult, control
+from avatarsim.sim.control.model import control_model
+from avatarsim.sim.soles import foot_bodies
 
 
 def _leaning(body, degrees: float, frames: int = 61) -> Motion:

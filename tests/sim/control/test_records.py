@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.control.records import FrameRecord, Recording
+from avatarsim.sim.control.records import FrameRecord, Recording
 
 
 def _record(frame: float) -> FrameRecord:

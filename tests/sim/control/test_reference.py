@@ -7,13 +7,13 @@ import mujoco
 import numpy as np
 import pytest
 
-from avatar_models.body import build_body
-from avatar_models.errors import MotionValueError
-from avatar_models.generator import generate
-from avatar_models.rigs import load_rig
-from sim.control.controller import Controller
-from sim.control.model import control_model
-from sim.control.reference import looped
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.errors import MotionValueError
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.sim.control.controller import Controller
+from avatarsim.sim.control.model import control_model
+from avatarsim.sim.control.reference import looped
 
 
 @pytest.fixture(scope="module")

@@ -6,9 +6,9 @@ import json
 
 import numpy as np
 
-from avatar_models.body17 import BODY17
-from sim.control.controller import ControlResult
-from sim.control.report import per_frame, write_outputs
+from avatarsim.avatar_models.body17 import BODY17
+from avatarsim.sim.control.controller import ControlResult
+from avatarsim.sim.control.report import per_frame, write_outputs
 
 
 def _result(frames: int = 10, fall_frame: int | None = 6) -> ControlResult:

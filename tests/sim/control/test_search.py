@@ -8,13 +8,13 @@ import mujoco
 import numpy as np
 import pytest
 
-from avatar_models.body import build_body
-from avatar_models.generator import generate
-from avatar_models.rigs import load_rig
-from sim.control.controller import Controller
-from sim.control.model import control_model
-from sim.control.reference import looped
-from sim.control.search import Beam, Node, SearchSettings, replay, search, state_cost
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.sim.control.controller import Controller
+from avatarsim.sim.control.model import control_model
+from avatarsim.sim.control.reference import looped
+from avatarsim.sim.control.search import Beam, Node, SearchSettings, replay, search, state_cost
 from tests.sim.control.test_controller import BANDAI_WALK, RootWatch, summary_line
 
 
@@ -64,8 +64,8 @@ def test_searched_walk_10_s_without_falling(body, seed):
 @pytest.mark.slow
 @pytest.mark.mocap
 def test_searched_bandai_walk_10_s_without_falling(mocap_dir):
-    from avatar_models.formats import load_motion
-    from sim.retarget import retarget
+    from avatarsim.avatar_models.formats import load_motion
+    from avatarsim.sim.retarget import retarget
 
     walk = retarget(load_motion(mocap_dir / BANDAI_WALK), level_feet=True)
     qpos = looped(walk.qpos, walk.motion.fps, 10.0)

@@ -6,13 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import Motion, quat
-from avatar_models.body import build_body
-from avatar_models.generator import generate
-from avatar_models.generator.subject import Subject
-from synthesis.avatargo.analytic_ik import LIMBS, AnalyticGoals, AnalyticIK
-from synthesis.avatargo.spine import bend_angle, spine_bend_in_root
-from synthesis.two_bone import unit
+from avatarsim.avatar_models import Motion, quat
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.generator.subject import Subject
+from avatarsim.synthesis.avatargo.analytic_ik import LIMBS, AnalyticGoals, AnalyticIK
+from avatarsim.synthesis.avatargo.spine import bend_angle, spine_bend_in_root
+from avatarsim.synthesis.two_bone import unit
 
 HEADING = quat.from_axis_angle(np.array([0.0, 0.0, 1.0]), np.array(0.6))
 

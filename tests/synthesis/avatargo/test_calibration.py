@@ -9,19 +9,19 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from avatar_models import Motion, quat
-from avatar_models.generator import sample_subject
-from avatar_models.generator.subject import subject_skeleton
-from render_cams.vr import FULL_BODY, VRSetup
-from synthesis.avatargo.calibration import (
+from avatarsim.avatar_models import Motion, quat
+from avatarsim.avatar_models.generator import sample_subject
+from avatarsim.avatar_models.generator.subject import subject_skeleton
+from avatarsim.render_cams.vr import FULL_BODY, VRSetup
+from avatarsim.synthesis.avatargo.calibration import (
     MissingDeviceError,
     NotTPoseError,
     SwappedTrackersError,
     classes_of,
     identify_roles,
 )
-from synthesis.avatargo.study import sample_user, setup_for
-from synthesis.avatargo.walk_in import t_pose, walk_in
+from avatarsim.synthesis.avatargo.study import sample_user, setup_for
+from avatarsim.synthesis.avatargo.walk_in import t_pose, walk_in
 
 
 def _sample(seed: int = 0):

@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.generator import sample_subject
-from avatar_models.generator.subject import subject_skeleton
-from avatar_models.rigs import load_rig
-from synthesis.avatargo.fingers import FingerIK, capsule_sdf, finger_points
-from synthesis.avatargo.hands import CONTROLLER_RADIUS_M, grip_of
+from avatarsim.avatar_models.generator import sample_subject
+from avatarsim.avatar_models.generator.subject import subject_skeleton
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.synthesis.avatargo.fingers import FingerIK, capsule_sdf, finger_points
+from avatarsim.synthesis.avatargo.hands import CONTROLLER_RADIUS_M, grip_of
 
 
 def test_capsule_sdf():

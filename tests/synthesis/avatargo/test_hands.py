@@ -5,13 +5,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models.generator import generate
-from avatar_models.generator.subject import Subject
-from avatar_models.rigs import load_rig
-from render_cams.vr import nominal_attachment
-from synthesis.avatargo.hands import CONTROLLER_RADIUS_M, beyond_reach, grip_of, out_of_reach
-from synthesis.avatargo.study import SimulatedUser, study_run
-from synthesis.avatargo.walk_in import t_pose
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.generator.subject import Subject
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.render_cams.vr import nominal_attachment
+from avatarsim.synthesis.avatargo.hands import (
+    CONTROLLER_RADIUS_M,
+    beyond_reach,
+    grip_of,
+    out_of_reach,
+)
+from avatarsim.synthesis.avatargo.study import SimulatedUser, study_run
+from avatarsim.synthesis.avatargo.walk_in import t_pose
 
 
 def test_grip_holds_the_handle_under_the_palm():

@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
-from avatar_models.body import build_body
-from avatar_models.body.ik import IKSettings
-from avatar_models.rigs import load_rig
-from synthesis.avatargo.least_squares_ik import LeastSquaresIK, rotation_log
-from synthesis.avatargo.synthesizer import ORIENTATION_COST, POSITION_COST, SITES
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body import build_body
+from avatarsim.avatar_models.body.ik import IKSettings
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.synthesis.avatargo.least_squares_ik import LeastSquaresIK, rotation_log
+from avatarsim.synthesis.avatargo.synthesizer import ORIENTATION_COST, POSITION_COST, SITES
 
 
 def test_rotation_log_is_scipys_rotation_vector():

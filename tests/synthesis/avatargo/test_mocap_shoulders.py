@@ -11,11 +11,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from avatar_models.formats.bvh import read_bvh
-from avatar_models.rigs import identify_rig
-from render_cams.vr.noise import Drift, Latency, PositionJitter, RotationJitter
-from sim.humanoid import humanoid_for
-from synthesis.avatargo.study import sample_user, study_run
+from avatarsim.avatar_models.formats.bvh import read_bvh
+from avatarsim.avatar_models.rigs import identify_rig
+from avatarsim.render_cams.vr.noise import Drift, Latency, PositionJitter, RotationJitter
+from avatarsim.sim.humanoid import humanoid_for
+from avatarsim.synthesis.avatargo.study import sample_user, study_run
 
 NOISE = (Latency(seconds=1 / 90), PositionJitter(), RotationJitter(), Drift())
 

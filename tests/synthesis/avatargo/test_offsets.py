@@ -7,15 +7,15 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from avatar_models import quat
-from avatar_models.generator import generate
-from avatar_models.generator.subject import Subject
-from render_cams.vr import Attachment
-from synthesis.avatargo.offsets import exact_offsets, fixed_offsets
-from synthesis.avatargo.study import EFFECTORS, ideal_user, setup_for
-from synthesis.avatargo.synthesizer import AvatarGo
-from synthesis.avatargo.walk_in import walk_in
-from synthesis.base import FrameBatch, on_clock
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.generator.subject import Subject
+from avatarsim.render_cams.vr import Attachment
+from avatarsim.synthesis.avatargo.offsets import exact_offsets, fixed_offsets
+from avatarsim.synthesis.avatargo.study import EFFECTORS, ideal_user, setup_for
+from avatarsim.synthesis.avatargo.synthesizer import AvatarGo
+from avatarsim.synthesis.avatargo.walk_in import walk_in
+from avatarsim.synthesis.base import FrameBatch, on_clock
 
 
 def test_exact_offsets_follow_a_rigidly_carried_joint():

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.generator import Subject, generate, sample_subject
-from render_cams.vr import nominal_attachment
-from render_cams.vr.noise import Drift, Latency, PositionJitter, RotationJitter
-from synthesis.avatargo.study import (
+from avatarsim.avatar_models.generator import Subject, generate, sample_subject
+from avatarsim.render_cams.vr import nominal_attachment
+from avatarsim.render_cams.vr.noise import Drift, Latency, PositionJitter, RotationJitter
+from avatarsim.synthesis.avatargo.study import (
     EFFECTORS,
     LIMB_SPREAD,
     PROXY,
@@ -24,8 +24,8 @@ from synthesis.avatargo.study import (
     strap,
     study_run,
 )
-from synthesis.avatargo.synthesizer import AvatarGo
-from synthesis.avatargo.walk_in import walk_in
+from avatarsim.synthesis.avatargo.synthesizer import AvatarGo
+from avatarsim.synthesis.avatargo.walk_in import walk_in
 
 # The realistic VR noise of the scenarios (scripts/stages/devices.py REALISTIC_NOISE).
 NOISE = (Latency(seconds=1 / 90), PositionJitter(), RotationJitter(), Drift())

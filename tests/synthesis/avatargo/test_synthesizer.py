@@ -6,15 +6,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import quat
-from avatar_models.generator import generate
-from avatar_models.generator.subject import Subject
-from synthesis.avatargo import AvatarGo
-from synthesis.avatargo.hands import REACH_SLACK_M
-from synthesis.avatargo.study import sample_user, setup_for
-from synthesis.avatargo.walk_in import walk_in
-from synthesis.base import FrameBatch, SynthesisError, TrackingFrame, on_clock
-from synthesis.methods import MethodInputs, build
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.generator.subject import Subject
+from avatarsim.synthesis.avatargo import AvatarGo
+from avatarsim.synthesis.avatargo.hands import REACH_SLACK_M
+from avatarsim.synthesis.avatargo.study import sample_user, setup_for
+from avatarsim.synthesis.avatargo.walk_in import walk_in
+from avatarsim.synthesis.base import FrameBatch, SynthesisError, TrackingFrame, on_clock
+from avatarsim.synthesis.methods import MethodInputs, build
 
 
 @pytest.fixture(scope="module")

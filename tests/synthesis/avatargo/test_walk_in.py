@@ -9,13 +9,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from avatar_models.formats.bvh import read_bvh
-from avatar_models.generator import generate
-from avatar_models.generator.subject import Subject
-from avatar_models.rigs import identify_rig, load_rig
-from render_cams.vr import FULL_BODY, VRSetup
-from synthesis.avatargo.calibration import classes_of, identify_roles
-from synthesis.avatargo.walk_in import is_t_pose, t_pose, walk_in
+from avatarsim.avatar_models.formats.bvh import read_bvh
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.generator.subject import Subject
+from avatarsim.avatar_models.rigs import identify_rig, load_rig
+from avatarsim.render_cams.vr import FULL_BODY, VRSetup
+from avatarsim.synthesis.avatargo.calibration import classes_of, identify_roles
+from avatarsim.synthesis.avatargo.walk_in import is_t_pose, t_pose, walk_in
 
 REAL_CLIPS = {
     "cmu": "cmu/09_01.bvh",

@@ -6,13 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import quat
-from avatar_models.body17_angles import angles_from_positions
-from avatar_models.generator import generate
-from avatar_models.rigs import body17_positions
-from synthesis.controllerpose.examples import Examples
-from synthesis.controllerpose.features import Features, skeleton_features, vr_features
-from synthesis.controllerpose.network import NetConfig
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.body17_angles import angles_from_positions
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.synthesis.controllerpose.examples import Examples
+from avatarsim.synthesis.controllerpose.features import Features, skeleton_features, vr_features
+from avatarsim.synthesis.controllerpose.network import NetConfig
 
 TINY_NET = NetConfig(branch_width=16, width=64, blocks=1, dropout=0.0)
 

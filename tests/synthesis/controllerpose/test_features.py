@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import quat
-from synthesis.controllerpose.features import (
+from avatarsim.avatar_models import quat
+from avatarsim.synthesis.controllerpose.features import (
     PER_SKELETON,
     FeatureError,
     Features,

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from avatar_models.body17_angles import angles_from_positions, positions_from_angles
-from avatar_models.generator import generate
-from avatar_models.rigs import body17_positions
-from synthesis.controllerpose.fk import forward_kinematics
+from avatarsim.avatar_models.body17_angles import angles_from_positions, positions_from_angles
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.synthesis.controllerpose.fk import forward_kinematics
 
 
 def test_torch_fk_equals_numpy_fk_on_random_and_real_angles():

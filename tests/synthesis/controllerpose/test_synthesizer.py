@@ -7,13 +7,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.body17 import INDEX
-from avatar_models.body17_angles import angles_from_positions
-from avatar_models.generator import generate
-from avatar_models.measure import standing_height
-from avatar_models.rigs import body17_positions
-from synthesis.controllerpose.checkpoint import untrained
-from synthesis.controllerpose.synthesizer import ControllerPose, KeypointRecording
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.avatar_models.body17_angles import angles_from_positions
+from avatarsim.avatar_models.generator import generate
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.rigs import body17_positions
+from avatarsim.synthesis.controllerpose.checkpoint import untrained
+from avatarsim.synthesis.controllerpose.synthesizer import ControllerPose, KeypointRecording
 
 LEFT = [INDEX["l_ankle"], INDEX["l_foot"]]
 RIGHT = [INDEX["r_ankle"], INDEX["r_foot"]]

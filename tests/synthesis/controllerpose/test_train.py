@@ -8,8 +8,8 @@ from dataclasses import replace
 import pytest
 import torch
 
-from synthesis.controllerpose.checkpoint import CheckpointError, load
-from synthesis.controllerpose.train import TrainConfig, predict, tensors, train
+from avatarsim.synthesis.controllerpose.checkpoint import CheckpointError, load
+from avatarsim.synthesis.controllerpose.train import TrainConfig, predict, tensors, train
 from tests.synthesis.controllerpose.conftest import TINY_NET, make_examples
 
 SHORT = TrainConfig(batch_size=16, max_epochs=3, patience=100, seed=0)

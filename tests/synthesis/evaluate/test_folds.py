@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import quat
-from avatar_models.generator import generate
-from synthesis.evaluate import EvaluationError, Trial, database_for, folds
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.generator import generate
+from avatarsim.synthesis.evaluate import EvaluationError, Trial, database_for, folds
 
 
 def _trial(cls, subject, take, motion=None):

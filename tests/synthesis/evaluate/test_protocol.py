@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from render_cams import VRSetup
-from synthesis.evaluate import (
+from avatarsim.render_cams import VRSetup
+from avatarsim.synthesis.evaluate import (
     EvaluationError,
     Fold,
     builtin_trials,
@@ -15,7 +15,7 @@ from synthesis.evaluate import (
     run_protocol,
     summarise,
 )
-from synthesis.methods import METHODS
+from avatarsim.synthesis.methods import METHODS
 
 
 def test_summary_is_the_mean_over_trials_and_the_pooled_rate():
@@ -72,10 +72,10 @@ def test_alignment_and_turned_copies_help_a_user_facing_away():
 def test_the_ik_rig_of_a_bandai_take_with_trackers_is_calibrated_on_three_devices():
     # Regression: the leaderboard's setup carries AvatarGo's trackers; on a Bandai take (rest
     # pose not upright) the IK baseline got all six attachments and every fold failed.
-    from avatar_models import Motion
-    from avatar_models.rigs import load_rig
-    from render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
-    from synthesis.evaluate.protocol import ik_rig_for
+    from avatarsim.avatar_models import Motion
+    from avatarsim.avatar_models.rigs import load_rig
+    from avatarsim.render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
+    from avatarsim.synthesis.evaluate.protocol import ik_rig_for
 
     skeleton = load_rig("bandai").skeleton
     still = np.tile([1.0, 0.0, 0.0, 0.0], (2, skeleton.n_joints, 1))

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.generator import Subject, generate
-from synthesis.evaluate import Trial, builtin_trials, turned
+from avatarsim.avatar_models.generator import Subject, generate
+from avatarsim.synthesis.evaluate import Trial, builtin_trials, turned
 
 
 def test_builtin_takes_differ_in_tempo_and_amplitude():

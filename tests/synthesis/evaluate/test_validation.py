@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
-from render_cams import VRSetup
-from synthesis.coolmoves import Options
-from synthesis.evaluate import builtin_trials, folds
-from synthesis.evaluate.validation import DISTANCE_GRID, choose_max_distance, validation_split
+from avatarsim.render_cams import VRSetup
+from avatarsim.synthesis.coolmoves import Options
+from avatarsim.synthesis.evaluate import builtin_trials, folds
+from avatarsim.synthesis.evaluate.validation import (
+    DISTANCE_GRID,
+    choose_max_distance,
+    validation_split,
+)
 
 
 def test_validation_split_holds_out_a_training_group():

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from avatar_models.generator import generate
-from render_cams.kinect import kinect_skeleton
+from avatarsim.avatar_models.generator import generate
+from avatarsim.render_cams.kinect import kinect_skeleton
 from tests.conftest import MOCAP_DIR, require
 
 SENSORS = ("kinect-v2", "azure-kinect")

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import quat
-from render_cams.kinect import TrackingState
-from synthesis.movebox.confidence import ConfidenceFilter, bone_states
+from avatarsim.avatar_models import quat
+from avatarsim.render_cams.kinect import TrackingState
+from avatarsim.synthesis.movebox.confidence import ConfidenceFilter, bone_states
 
 T, I, N = TrackingState.TRACKED, TrackingState.INFERRED, TrackingState.NOT_TRACKED
 Z = np.array([0.0, 0.0, 1.0])

@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.rigs import load_rig
-from synthesis.movebox.face import (
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.synthesis.movebox.face import (
     BLINK_RATES_PER_MIN,
     AudioFormatError,
     blinks,

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.generator import generate
-from synthesis.base import SynthesisError
-from synthesis.movebox.face import face_motion
-from synthesis.movebox.masks import BONE_SETS, Layer, bone_set, compose
+from avatarsim.avatar_models.generator import generate
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.movebox.face import face_motion
+from avatarsim.synthesis.movebox.masks import BONE_SETS, Layer, bone_set, compose
 
 
 @pytest.fixture(scope="module")

@@ -6,11 +6,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models.generator import Subject, generate
-from avatar_models.rigs import load_rig
-from synthesis.base import SynthesisError
-from synthesis.movebox.recording import crop, load_recording, looped, playback, save_recording
-from synthesis.movebox.resize import resized
+from avatarsim.avatar_models.generator import Subject, generate
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.movebox.recording import (
+    crop,
+    load_recording,
+    looped,
+    playback,
+    save_recording,
+)
+from avatarsim.synthesis.movebox.resize import resized
 
 
 @pytest.fixture(scope="module")

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import pytest
 
-from avatar_models.generator import Subject, generate
-from avatar_models.measure import standing_height
-from avatar_models.rigs import load_rig
-from render_cams.kinect import kinect_skeleton
-from synthesis.base import SynthesisError
-from synthesis.movebox.resize import resized, user_height_m
+from avatarsim.avatar_models.generator import Subject, generate
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.rigs import load_rig
+from avatarsim.render_cams.kinect import kinect_skeleton
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.movebox.resize import resized, user_height_m
 
 
 @pytest.mark.parametrize("height", [1.58, 1.9])

@@ -7,17 +7,17 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import Motion, quat
-from avatar_models.body17 import INDEX
-from avatar_models.formats import load_motion
-from avatar_models.measure import standing_height
-from avatar_models.rigs import body17_positions, load_rig
-from render_cams.device import motion_at_rate
-from render_cams.kinect import kinect_skeleton
-from render_cams.kinect.rig_joints import rig_joints
-from synthesis.movebox.mapping import mapping_for
-from synthesis.movebox.resize import resized
-from synthesis.movebox.retarget import Retargeting, shortest_arc, twist_angle
+from avatarsim.avatar_models import Motion, quat
+from avatarsim.avatar_models.body17 import INDEX
+from avatarsim.avatar_models.formats import load_motion
+from avatarsim.avatar_models.measure import standing_height
+from avatarsim.avatar_models.rigs import body17_positions, load_rig
+from avatarsim.render_cams.device import motion_at_rate
+from avatarsim.render_cams.kinect import kinect_skeleton
+from avatarsim.render_cams.kinect.rig_joints import rig_joints
+from avatarsim.synthesis.movebox.mapping import mapping_for
+from avatarsim.synthesis.movebox.resize import resized
+from avatarsim.synthesis.movebox.retarget import Retargeting, shortest_arc, twist_angle
 from tests.conftest import require
 from tests.synthesis.movebox.conftest import SENSORS
 

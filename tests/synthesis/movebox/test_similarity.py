@@ -6,10 +6,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from avatar_models import quat
-from avatar_models.generator import STYLES, Subject, generate
-from synthesis.base import SynthesisError
-from synthesis.movebox.similarity import loop_points, similarity_index, similarity_matrix
+from avatarsim.avatar_models import quat
+from avatarsim.avatar_models.generator import STYLES, Subject, generate
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.movebox.similarity import loop_points, similarity_index, similarity_matrix
 
 
 def test_index_is_zero_for_equal_states_and_the_sum_of_half_angle_sines():

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatar_models import quat
-from synthesis.movebox.smoothing import ExponentialSmoother, smoothing_alpha
+from avatarsim.avatar_models import quat
+from avatarsim.synthesis.movebox.smoothing import ExponentialSmoother, smoothing_alpha
 
 
 def test_step_response_reaches_one_minus_1_over_e_after_tau():
@@ -41,7 +41,7 @@ def test_smoothing_reduces_rotation_jitter():
 
 
 def test_absolute_is_the_product_down_the_hierarchy_and_relative_undoes_it(box_truth):
-    from synthesis.movebox.smoothing import absolute, relative
+    from avatarsim.synthesis.movebox.smoothing import absolute, relative
 
     local = box_truth.local_rot[:5]
     world = absolute(local, box_truth.skeleton.parents)

@@ -7,10 +7,10 @@ import mujoco
 import numpy as np
 import pytest
 
-from avatar_models.generator import generate
-from synthesis.base import SynthesisError
-from synthesis.movebox.face import LipSync
-from synthesis.movebox.storytelling import Actor, drawn_bones, scene_spec, stage
+from avatarsim.avatar_models.generator import generate
+from avatarsim.synthesis.base import SynthesisError
+from avatarsim.synthesis.movebox.face import LipSync
+from avatarsim.synthesis.movebox.storytelling import Actor, drawn_bones, scene_spec, stage
 
 
 @pytest.fixture(scope="module")

@@ -8,11 +8,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from render_cams.kinect import TrackingState
-from render_cams.vr import VRSetup
-from synthesis.base import SynthesisError, TrackingFrame
-from synthesis.methods import MethodInputs, build
-from synthesis.movebox import MoveBox
+from avatarsim.render_cams.kinect import TrackingState
+from avatarsim.render_cams.vr import VRSetup
+from avatarsim.synthesis.base import SynthesisError, TrackingFrame
+from avatarsim.synthesis.methods import MethodInputs, build
+from avatarsim.synthesis.movebox import MoveBox
 
 
 @pytest.fixture(scope="module")
@@ -75,8 +75,8 @@ def test_record_is_the_stream_on_the_display_clock(noisy_kinect, box_truth):
 
 
 def test_registry_drives_a_resized_avatar_for_a_foreign_rig(noisy_kinect):
-    from avatar_models.measure import standing_height
-    from avatar_models.rigs import load_rig
+    from avatarsim.avatar_models.measure import standing_height
+    from avatarsim.avatar_models.rigs import load_rig
 
     inputs = MethodInputs(
         lambda: None, 1.62, load_rig("cmu").skeleton, kinect=noisy_kinect["kinect-v2"]
