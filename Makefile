@@ -53,6 +53,12 @@ lock: $(BIN)/uv
 		echo "requirements.lock pulls CUDA packages: torch came from the index, not $(WHEELS)" >&2; \
 		exit 1; fi
 
+# Real mocap beside the checkout is what `mocap:` motion sources (the shipped real-clip
+# scenarios) and `bench` read; an installed avatarsim reads $AVATARSIM_MOCAP the same way.
+ifneq ($(wildcard ../shared/mocap),)
+export AVATARSIM_MOCAP ?= $(abspath ../shared/mocap)
+endif
+
 demo: $(STAMP)
 	$(BIN)/avatarsim demo --out $(OUT)
 
@@ -70,7 +76,7 @@ test-slow: $(STAMP)
 	$(BIN)/python -m pytest -q -n 2 --dist loadfile -m slow --durations=0
 
 bench: $(STAMP)
-	$(BIN)/avatarsim bench $(if $(wildcard ../shared/mocap),--mocap ../shared/mocap)
+	$(BIN)/avatarsim bench
 
 clean:
 	rm -rf $(VENV) out .pytest_cache .hypothesis

@@ -232,9 +232,11 @@ def load_motion_arg(
     min_frames: int = 1,
     check_height: bool = True,
 ):
-    """A motion file path, or ``builtin:ACTIVITY`` for the built-in generator (any command
-    that takes a MOTION accepts both). A clip shorter than ``min_frames`` frames or (with
-    ``check_height``) a body of no person's height is bad input."""
+    """A motion file path, ``mocap:RELATIVE/PATH`` inside the mocap folder
+    (:mod:`avatarsim.avatar_models.mocap_dir`), or ``builtin:ACTIVITY`` for the built-in
+    generator (any command that takes a MOTION accepts all three). A clip shorter than
+    ``min_frames`` frames or (with ``check_height``) a body of no person's height is bad
+    input."""
     if arg.startswith(BUILTIN_PREFIX):
         from avatarsim.avatar_models.generator import ACTIVITIES, generate
 
@@ -248,8 +250,10 @@ def load_motion_arg(
         return generate(activity, duration_s=duration_s, seed=seed)
     from avatarsim.avatar_models.formats import load_motion
     from avatarsim.avatar_models.measure import check_plausible_height
+    from avatarsim.avatar_models.mocap_dir import is_mocap_source, resolve_mocap_source
 
-    m = load_motion(Path(arg), **unit_option(unit))
+    path = resolve_mocap_source(arg) if is_mocap_source(arg) else Path(arg)
+    m = load_motion(path, **unit_option(unit))
     if m.n_frames < min_frames:
         raise MotionValueError(
             f"{arg}: too short: {m.n_frames} frame(s); this command needs at least "

@@ -38,7 +38,9 @@ from pathlib import Path
 from typing import Any, Literal
 
 from avatarsim.avatar_models.config import ConfigError, from_data, read_toml, setting
+from avatarsim.avatar_models.errors import AvatarsimError
 from avatarsim.avatar_models.memory import FRAME_BYTES, require_memory
+from avatarsim.avatar_models.mocap_dir import MocapUnset, is_mocap_source, resolve_mocap_source
 from avatarsim.avatar_models.motion import FPS_RANGE
 from avatarsim.render_cams.kinect.sensors import SENSORS
 
@@ -250,13 +252,23 @@ def load_scenario(path: str | Path) -> Scenario:
         raise ScenarioError(str(exc)) from None
     scenario = parse_scenario(data, str(path))
     source = scenario.motion.source
-    if source != "builtin" and not Path(source).is_absolute():
+    if is_mocap_source(source):
+        try:
+            resolved = resolve_mocap_source(source)
+        except MocapUnset as exc:
+            if scenario.motion.skip_if_absent:
+                return scenario  # the suite skips it, naming the unset folder
+            raise ScenarioError(f"{path}: motion.source {exc}") from None
+        except AvatarsimError as exc:
+            raise ScenarioError(f"{path}: motion.source {exc}") from None
+    elif source != "builtin" and not Path(source).is_absolute():
         # Motion files are relative to the scenario file, so scenarios can travel with data.
         resolved = (path.parent / source).resolve()
-        scenario = dataclasses.replace(
-            scenario, motion=dataclasses.replace(scenario.motion, source=str(resolved))
-        )
-    return scenario
+    else:
+        return scenario
+    return dataclasses.replace(
+        scenario, motion=dataclasses.replace(scenario.motion, source=str(resolved))
+    )
 
 
 DEFAULT_SCENARIO = Path(__file__).parent / "scenarios" / "default.toml"

@@ -23,6 +23,10 @@ MOCAP_DIR = Path(
         "AVATARSIM_MOCAP", Path(__file__).resolve().parents[1].parent / "shared" / "mocap"
     )
 )
+# What `mocap:` motion sources (shipped real-clip scenarios) read, in this process and in the
+# commands tests start as subprocesses.
+if MOCAP_DIR.is_dir():
+    os.environ.setdefault("AVATARSIM_MOCAP", str(MOCAP_DIR))
 
 
 def in_ci() -> bool:

@@ -11,6 +11,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+from avatarsim.avatar_models.mocap_dir import MOCAP_ENV, is_mocap_source
 from avatarsim.scripts.pipeline import validate
 from avatarsim.scripts.scenario import Scenario, ScenarioError, load_scenario
 
@@ -63,6 +64,8 @@ def check_scenario(path: Path, seed: int | None = None) -> SuiteEntry:
     if source == "builtin" or Path(source).is_file():
         return SuiteEntry(scenario)
     if scenario.motion.skip_if_absent:
+        if is_mocap_source(source):
+            return SuiteEntry(scenario, f"{source}: no mocap folder set ({MOCAP_ENV} or --mocap)")
         return SuiteEntry(scenario, f"motion file {source} is absent (motion.skip_if_absent)")
     raise ScenarioError(f"motion file {source} does not exist")
 

@@ -486,3 +486,18 @@ def test_out_that_is_the_working_folder_or_holds_the_export_exits_2(tmp_path, mo
         result = runner.invoke(app, args)
         assert result.exit_code == 2, (args, result.output)
     assert sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+def test_a_mocap_motion_without_a_mocap_folder_names_the_variable(monkeypatch):
+    monkeypatch.delenv("AVATARSIM_MOCAP", raising=False)
+    bad(["info", "mocap:cmu/09_01.bvh"], "mocap:cmu/09_01.bvh", "AVATARSIM_MOCAP")
+
+
+@pytest.mark.mocap
+def test_a_mocap_motion_is_read_from_the_mocap_folder(mocap_dir, monkeypatch):
+    clip = cmu_09_01(mocap_dir)
+    monkeypatch.setenv("AVATARSIM_MOCAP", str(mocap_dir))
+    by_name = runner.invoke(app, ["info", "mocap:cmu/09_01.bvh"])
+    by_path = runner.invoke(app, ["info", str(clip)])
+    assert by_name.exit_code == 0, by_name.output
+    assert by_name.stdout.replace("mocap:cmu/09_01.bvh", str(clip)) == by_path.stdout

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 
+from avatarsim.avatar_models.mocap_dir import MOCAP_ENV
 from avatarsim.scripts.scenario import ScenarioError
 from avatarsim.scripts.suite.discovery import load_suite, scenario_files, selected
 from tests.scripts.suite.conftest import write_scenario
@@ -63,6 +64,35 @@ def test_a_missing_motion_file_is_bad_unless_it_may_be_skipped(tmp_path):
     )
     (entry,) = load_suite([tmp_path / "a"])
     assert "absent" in entry.skip_reason
+
+
+@pytest.mark.mocap
+def test_shipped_real_clip_scenarios_read_the_mocap_folder(mocap_dir, monkeypatch):
+    """``mocap:`` sources resolve inside $AVATARSIM_MOCAP, wherever the scenario file is."""
+    monkeypatch.setenv(MOCAP_ENV, str(mocap_dir))
+    entries = load_suite([SHIPPED / "methods", SHIPPED / "devices"])
+    real = [e for e in entries if e.scenario.motion.skip_if_absent]
+    assert len(real) >= 5
+    for entry in real:
+        assert entry.skip_reason is None
+        source = Path(entry.scenario.motion.source)
+        assert source.is_file() and source.is_relative_to(mocap_dir), source
+
+
+def test_shipped_real_clip_scenarios_skip_without_a_mocap_folder(monkeypatch):
+    monkeypatch.delenv(MOCAP_ENV, raising=False)
+    entries = load_suite([SHIPPED / "methods", SHIPPED / "devices"])
+    skipped = [e for e in entries if e.skip_reason]
+    assert skipped and all(MOCAP_ENV in e.skip_reason for e in skipped)
+    assert all(e.scenario.motion.source == "builtin" for e in entries if not e.skip_reason)
+
+
+def test_a_mocap_source_that_may_not_be_skipped_needs_the_folder(tmp_path, monkeypatch):
+    monkeypatch.delenv(MOCAP_ENV, raising=False)
+    path = write_scenario(tmp_path, "real", motion='source = "mocap:cmu/16_35.bvh"')
+    path.write_text(path.read_text().replace('activity = "walk"\n', ""))
+    with pytest.raises(ScenarioError, match=MOCAP_ENV):
+        load_suite([tmp_path])
 
 
 def test_k_selects_by_substring_or_glob_and_refuses_an_empty_selection(tmp_path):
