@@ -3,13 +3,19 @@ from __future__ import annotations
 import json
 
 import numpy as np
+from matplotlib.colors import to_rgb
 from PIL import Image
 from typer.testing import CliRunner
 
 from avatarsim.scripts.cli import app
 from avatarsim.scripts.dataset.config import load_config
 from avatarsim.scripts.dataset.manifest import read_manifest
-from avatarsim.scripts.dataset.preview import SKELETON_LINES, preview_sheet, skeleton_pixels
+from avatarsim.scripts.dataset.preview import (
+    SIDE_COLOURS,
+    SKELETON_LINES,
+    preview_sheet,
+    skeleton_pixels,
+)
 from avatarsim.scripts.dataset.runner import generate
 from avatarsim.scripts.dataset.shards import read_samples
 from tests.scripts.dataset.builders import write_config
@@ -31,6 +37,13 @@ def test_preview_draws_random_samples_of_the_dataset(tiny_dataset, tmp_path):
     image = np.asarray(Image.open(tmp_path / "a.png").convert("L"))
     assert image.shape == (300, 1200)  # 1 row x 4 columns of 3 in at 100 dpi
     assert (image < 128).mean() > 0.002  # lines and dots, not an empty sheet
+    # Each panel draws both sides' limbs in their own colours (left blue, right red): a
+    # sheet with frames and titles but no skeleton, or one side lost, fails here.
+    rgb = np.asarray(Image.open(tmp_path / "a.png").convert("RGB")).astype(float)
+    for colour in SIDE_COLOURS.values():
+        near = np.linalg.norm(rgb - 255 * np.array(to_rgb(colour)), axis=-1) < 40
+        per_panel = near.reshape(300, 4, 300).sum(axis=(0, 2))
+        assert per_panel.min() > 5, (colour, per_panel)  # min 17 over 10 seeds x 4 panels
     other = preview_sheet(tiny_dataset, tmp_path / "c.png", samples=4, seed=2)
     assert [p["key"] for p in other] != keys  # another seed, other samples
 

@@ -81,3 +81,35 @@ def test_counts_skips_errors_and_regressions(tmp_path):
     assert suites["b"].find("testcase/skipped").get("message") == "motion file x is absent"
     (tmp_path / "junit.xml").write_text(text)
     require_module("xmlschema").XMLSchema(XSD).validate(tmp_path / "junit.xml")
+
+
+def test_junitparser_reads_the_suite_junit(tmp_path):
+    """A second, independent reader (junitparser) counts the same suites, cases and results."""
+    junitparser = require_module("junitparser")
+    ok = {"name": "frames", "value": 9.0, "threshold": 10.0, "passed": True}
+    bad = {"name": "float_cm_p95", "value": 9.0, "threshold": 5.0, "passed": False}
+    records = [
+        record("a", "failed", [ok, bad]),
+        record("b", "skipped", message="motion file x is absent"),
+        record("c", "error", message="internal error: boom"),
+    ]
+    path = tmp_path / "junit.xml"
+    path.write_text(suite_junit(records))
+    suites = {s.name: s for s in junitparser.JUnitXml.fromfile(str(path))}
+    assert sorted(suites) == ["a", "b", "c"]
+    results = {
+        (name, case.name): [type(r).__name__ for r in case.result]
+        for name, suite in suites.items()
+        for case in suite
+    }
+    assert results[("a", "frames")] == [] and results[("a", "float_cm_p95")] == ["Failure"]
+    assert [r for (s, _), r in results.items() if s in "bc"] == [["Skipped"], ["Error"]]
+    (skip,) = next(iter(suites["b"])).result
+    assert skip.message == "motion file x is absent"
+    (failure,) = next(c for c in suites["a"] if c.name == "float_cm_p95").result
+    assert failure.message == "float_cm_p95 = 9 cm, threshold <= 5 cm"
+    assert [(s.tests, s.failures, s.errors, s.skipped) for s in suites.values()] == [
+        (2, 1, 0, 0),
+        (1, 0, 0, 1),
+        (1, 0, 1, 0),
+    ]
