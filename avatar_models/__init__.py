@@ -19,10 +19,22 @@ from avatarsim.avatar_models.errors import (
     RigError,
     UnknownJointError,
 )
+from avatarsim.avatar_models.lazy_exports import lazy_exports
 from avatarsim.avatar_models.motion import Motion
 from avatarsim.avatar_models.skeleton import Skeleton
 
+# Loaded on first use (formats and the generator import more than a bare ``import`` needs).
+_EXPORTS = {
+    "load_motion": ".formats",
+    "save_motion": ".formats",
+    "ACTIVITIES": ".generator",
+    "generate": ".generator",
+}
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
+
+
 __all__ = [
+    *_EXPORTS,
     "AvatarsimError",
     "CalibrationError",
     "Motion",

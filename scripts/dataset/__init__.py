@@ -15,3 +15,19 @@ One concept per module:
 - :mod:`.torch_dataset`: a torch ``IterableDataset`` over the shards;
 - :mod:`.preview`: a picture sheet of random samples with their ground-truth skeleton.
 """
+
+from avatarsim.avatar_models.lazy_exports import lazy_exports
+
+_EXPORTS = {
+    "DatasetConfig": ".config",
+    "load_config": ".config",
+    "generate": ".runner",
+    "GenerateResult": ".runner",
+    "read_manifest": ".manifest",
+    "read_samples": ".shards",
+    "VerifyReport": ".verify",
+    "verify_dataset": ".verify",
+    "ShardDataset": ".torch_dataset",
+}
+__all__ = sorted(_EXPORTS)
+__getattr__, __dir__ = lazy_exports(__name__, _EXPORTS)
