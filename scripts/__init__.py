@@ -10,6 +10,7 @@ _EXPORTS = {
     "Scenario": ".scenario",
     "ScenarioError": ".scenario",
     "load_scenario": ".scenario",
+    "parse_scenario": ".scenario",
     "run_scenario": ".pipeline",
     "SuiteEntry": ".suite.discovery",
     "load_suite": ".suite.discovery",
