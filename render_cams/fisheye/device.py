@@ -140,8 +140,8 @@ class FisheyeRig:
                 skeleton.
 
         Raises:
-            RigError: a skeleton without a body17 map; SceneError: ``motion`` not on
-            ``body``'s skeleton.
+            RigError: a skeleton without a body17 map.
+            SceneError: ``motion`` is not on ``body``'s skeleton.
         """
         seed = resolve_seed(seed)
         model = self.model

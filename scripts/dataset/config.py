@@ -149,8 +149,9 @@ def load_config(path: str | Path) -> DatasetConfig:
     (:func:`scripts.dataset.budget.check_budget`).
 
     Raises:
-        ConfigError: unreadable file, bad TOML, unknown key, a value of the wrong type or
-        range, empty source, bad split fractions, more memory than the machine has.
+        ConfigError: an unreadable file, bad TOML, an unknown key, a value of the wrong
+            type or range, an empty source, bad split fractions, or more memory than the
+            machine has.
     """
     path = Path(path)
     data = read_toml(path)

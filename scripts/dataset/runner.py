@@ -161,8 +161,8 @@ def generate(
         workers: shards made at once (processes or Ray tasks); local 1 makes them here.
         on_start: called with (samples in all, samples already done) before any work.
         on_shard: called with the samples of each shard as it completes.
-        executor, address: ``"local"`` or ``"ray"``, and a Ray cluster to attach to
-            (:func:`scripts.dataset.executors.run`).
+        executor: ``"local"`` or ``"ray"`` (:func:`scripts.dataset.executors.run`).
+        address: the Ray cluster to attach to (``"auto"``, ``"ray://HEAD:10001"``).
 
     Raises:
         DatasetError: ``root`` is foreign, or a write failed (resume later).
