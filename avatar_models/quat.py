@@ -98,6 +98,42 @@ def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     )
 
 
+_ARC_EPS = 1e-12
+_X_AXIS, _Y_AXIS = np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0])
+
+
+def shortest_arc(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``(..., 4)`` smallest rotations turning the directions of ``a`` onto ``b`` ``(..., 3)``.
+
+    Edge cases: the identity where either vector is (near) zero; for opposite directions,
+    which have no single smallest rotation, a half turn about an axis perpendicular to ``a``
+    (about ``a x X``, or ``a x Y`` when ``a`` is near X), so the result still turns ``a``
+    onto ``b``.
+    """
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    return unit_arc(a / np.maximum(_len(a), _ARC_EPS), b / np.maximum(_len(b), _ARC_EPS))
+
+
+def unit_arc(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """:func:`shortest_arc` of directions ``a``, ``b`` ``(..., 3)`` already of unit length
+    (or zero): the step's hot path, which has normalised them already."""
+    cos = np.add.reduce(a * b, axis=-1, keepdims=True)
+    q = np.concatenate([1.0 + cos, cross(a, b)], axis=-1)
+    opposite = q[..., :1] <= _ARC_EPS
+    if opposite.any():
+        helper = np.where(np.abs(a[..., :1]) < 0.9, _X_AXIS, _Y_AXIS)
+        half_turn = np.concatenate([np.zeros_like(cos), cross(a, helper)], axis=-1)
+        q = np.where(opposite, half_turn, q)
+    norm = _len(q)
+    # Zero input: q is (1, 0, 0, 0) already; a zero helper axis (a itself zero) is identity.
+    return np.where(norm > _ARC_EPS, q / np.maximum(norm, _ARC_EPS), IDENTITY)
+
+
+def _len(v: np.ndarray) -> np.ndarray:
+    """``|v| (..., 1)`` over the last axis (np.linalg.norm's sum, without its wrapper)."""
+    return np.sqrt(np.add.reduce(v * v, axis=-1, keepdims=True))
+
+
 def to_matrix(q: np.ndarray) -> np.ndarray:
     """``(..., 4)`` -> rotation matrices ``(..., 3, 3)``."""
     q = np.asarray(q, dtype=float)

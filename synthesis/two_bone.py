@@ -67,27 +67,10 @@ def _norm(v: np.ndarray) -> np.ndarray:
 
 def unit(v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Directions ``(..., 3)`` and lengths ``(...)`` of vectors ``v (..., 3)`` (a zero vector
-    stays zero): the normalisation :func:`shortest_arc` applies, for callers that pass
-    :func:`unit_arc` directions they already have."""
+    stays zero): the normalisation :func:`avatar_models.quat.shortest_arc` applies, for
+    callers that pass :func:`avatar_models.quat.unit_arc` directions they already have."""
     norm = _norm(v)
     return v / np.maximum(norm, _EPS), norm[..., 0]
-
-
-def shortest_arc(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``(..., 4)`` smallest rotations turning directions ``a`` onto ``b`` ``(..., 3)``."""
-    return unit_arc(unit(a)[0], unit(b)[0])
-
-
-def unit_arc(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """:func:`shortest_arc` of directions ``a``, ``b`` ``(..., 3)`` already normalised by
-    :func:`unit` (normalising twice would change the last bits)."""
-    cos = np.add.reduce(a * b, axis=-1, keepdims=True)
-    q = np.concatenate([1.0 + cos, quat.cross(a, b)], axis=-1)
-    # Antiparallel directions (a bone onto its reverse, a back bent double) have no single
-    # shortest arc: identity there, as for parallel ones (normalised after the choice: the
-    # arc's own norm there is ~0, and dividing the identity by it gave 1e12).
-    q = np.where(q[..., :1] > _EPS, q, quat.IDENTITY)
-    return q / np.maximum(_norm(q), _EPS)
 
 
 def _in_frame(q: np.ndarray, frame: np.ndarray) -> np.ndarray:
@@ -145,7 +128,7 @@ def solve(
     turn_lower = quat.from_axis_angle(normal, np.arccos(cos_bend) - bend_now)
     new_c = b + quat.rotate(turn_lower, arms[..., 1, :])
     # 2. Swing the whole limb at the root, by the smallest rotation, onto the target.
-    turn_upper = unit_arc(unit(new_c - a)[0], to_target)
+    turn_upper = quat.unit_arc(unit(new_c - a)[0], to_target)
     # The end joint keeps its global rotation: undo both turns in the old middle frame.
     both = quat.mul(turn_upper, turn_lower)
     # The three turns in the frames of the parent, upper and middle joints (the first three

@@ -26,7 +26,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatarsim.synthesis.two_bone import shortest_arc, unit, unit_arc
+from avatarsim.avatar_models import quat
+from avatarsim.synthesis.two_bone import unit
 
 
 def bend_angle(w0: np.ndarray, w: np.ndarray) -> np.ndarray:
@@ -38,7 +39,7 @@ def bend_angle(w0: np.ndarray, w: np.ndarray) -> np.ndarray:
 def spine_bend(w0: np.ndarray, w: np.ndarray) -> np.ndarray:
     """``(B, 4)`` wxyz rotations by ``alpha_t`` about ``w0 x w_t`` (identity where parallel):
     each turns the direction of ``w0 (3,)`` onto that of ``w (B, 3)``, the shortest arc."""
-    return shortest_arc(w0, w)  # broadcasts
+    return quat.shortest_arc(w0, w)  # broadcasts
 
 
 def spine_bend_in_root(w0_in_root: np.ndarray, w: np.ndarray, root_mat: np.ndarray) -> np.ndarray:
@@ -49,4 +50,4 @@ def spine_bend_in_root(w0_in_root: np.ndarray, w: np.ndarray, root_mat: np.ndarr
     docstring; the caller has them already, a tick's hot path)."""
     # R^T w by a matrix product: fewer numpy calls than quat.rotate on a tick's vectors.
     w_in_root = (np.asarray(w)[..., None, :] @ root_mat)[..., 0, :]
-    return unit_arc(w0_in_root, unit(w_in_root)[0])
+    return quat.unit_arc(w0_in_root, unit(w_in_root)[0])

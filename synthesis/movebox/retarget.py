@@ -52,26 +52,6 @@ def rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
     return (quat.unit_to_matrix(q) @ np.asarray(v, float)[..., None])[..., 0]
 
 
-def shortest_arc(u: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """``(..., 4)`` smallest rotations taking directions ``u (..., 3)`` to ``v (..., 3)``;
-    identity where either is (near) zero, a half turn about a perpendicular when opposite."""
-    u = np.asarray(u, float)
-    v = np.asarray(v, float)
-    nu = np.linalg.norm(u, axis=-1, keepdims=True)
-    nv = np.linalg.norm(v, axis=-1, keepdims=True)
-    degenerate = ((nu < 1e-12) | (nv < 1e-12))[..., 0]
-    u = u / np.maximum(nu, 1e-12)
-    v = v / np.maximum(nv, 1e-12)
-    w = 1.0 + np.sum(u * v, axis=-1)
-    axis = quat.cross(u, v)
-    opposite = w < 1e-9
-    perpendicular = quat.cross(u, np.where(np.abs(u[..., :1]) < 0.9, [1.0, 0, 0], [0, 1.0, 0]))
-    axis = np.where(opposite[..., None], perpendicular, axis)
-    q = np.concatenate([np.where(opposite, 0.0, w)[..., None], axis], axis=-1)
-    q = np.where(degenerate[..., None], quat.IDENTITY, q)
-    return q / np.linalg.norm(q, axis=-1, keepdims=True)
-
-
 def frame_from_pair(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``(..., 3, 3)`` orthonormal frames from two vectors ``(..., 3)``: x along ``a + b``,
     z along ``a x b``; the identity where they are (near) parallel or zero (a garbage frame
@@ -125,7 +105,7 @@ class Retargeting:
         """``(4,)`` rotation taking the avatar bone's rest direction to the Kinect rest bone
         its orientation turns (so that the Kinect orientation applies to the avatar bone)."""
         a, b = (self.kinect_index(n) for n in drive.orient_rest)
-        return shortest_arc(
+        return quat.shortest_arc(
             self.target.offsets[self.target.index(drive.child)],
             self.kinect_rest[b] - self.kinect_rest[a],
         )
@@ -221,7 +201,7 @@ class Retargeting:
             return world
         bone = self.target.offsets[self.target.index(drive.child)]
         target = positions[:, self.kinect_index(drive.aim)] - start
-        world = quat.mul(shortest_arc(rotate(world, bone), target), world)
+        world = quat.mul(quat.shortest_arc(rotate(world, bone), target), world)
         if self.roll == "hinge" and drive.bend is not None:
             world = self._hinge_roll(
                 drive, world, positions[:, self.kinect_index(drive.aim)], positions

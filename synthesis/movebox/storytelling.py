@@ -23,7 +23,6 @@ from avatarsim.synthesis.base import SynthesisError
 from avatarsim.synthesis.movebox.face import LipSync, blinks, face_motion
 from avatarsim.synthesis.movebox.masks import Layer, compose
 from avatarsim.synthesis.movebox.recording import looped
-from avatarsim.synthesis.movebox.retarget import shortest_arc
 
 MIN_BONE_M = 0.02
 """Bones shorter than this are not drawn (finger joints, face)."""
@@ -106,7 +105,7 @@ def scene_spec(motions: list[Motion], key_fps: float) -> mujoco.MjSpec:
                 conaffinity=0,
             )
         poses_pos.append(0.5 * (start + end))
-        poses_quat.append(shortest_arc(np.array([0.0, 0.0, 1.0]), end - start))
+        poses_quat.append(quat.shortest_arc(np.array([0.0, 0.0, 1.0]), end - start))
     mpos = np.concatenate(poses_pos, axis=1)
     mquat = quat.normalize(np.concatenate(poses_quat, axis=1))
     for k in range(mpos.shape[0]):

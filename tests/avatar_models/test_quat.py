@@ -99,3 +99,32 @@ def test_conversions_do_not_depend_on_the_batch():
     assert np.array_equal(euler, alone)
     back = np.stack([quat.from_euler(euler[i : i + 1], axes)[0] for i in range(len(q))])
     assert np.array_equal(quat.from_euler(euler, axes), back)
+
+
+def test_shortest_arc_is_scipys_aligning_rotation_of_the_two_directions():
+    rng = np.random.default_rng(0)
+    a, b = rng.normal(size=(40, 3)), rng.normal(size=(40, 3)) * 3.0
+    q = quat.shortest_arc(a, b)
+    for qi, ai, bi in zip(q, a, b, strict=True):
+        # scipy's align_vectors with one pair gives the smallest rotation taking ai onto bi
+        expected, _ = Rotation.align_vectors(bi[None], ai[None])
+        assert (quat.to_scipy(qi).inv() * expected).magnitude() < 1e-9
+    np.testing.assert_allclose(np.linalg.norm(q, axis=-1), 1.0)
+
+
+@pytest.mark.parametrize("a", [[1.0, 0.0, 0.0], [0.0, 0.0, 2.0], [0.3, -0.4, 0.5]])
+def test_shortest_arc_of_opposite_directions_is_a_half_turn_onto_b(a):
+    a = np.array(a)
+    q = quat.shortest_arc(a, -a)
+    assert abs(q[0]) < 1e-12  # a half turn
+    np.testing.assert_allclose(quat.rotate(q, a), -a, atol=1e-12)
+    assert abs(q[1:] @ a) < 1e-12  # about an axis perpendicular to a
+
+
+def test_shortest_arc_of_a_zero_vector_is_the_identity():
+    zero, v = np.zeros(3), np.array([0.0, 1.0, 0.0])
+    for a, b in ((zero, v), (v, zero), (zero, zero)):
+        np.testing.assert_array_equal(quat.shortest_arc(a, b), quat.IDENTITY)
+    # unit_arc on directions already normalised gives the same turn to the last bits
+    a, b = np.array([0.6, 0.0, 0.8]), np.array([0.0, 1.0, 0.0])
+    np.testing.assert_allclose(quat.unit_arc(a, b), quat.shortest_arc(5 * a, 2 * b), atol=1e-15)

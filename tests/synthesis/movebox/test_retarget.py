@@ -17,7 +17,7 @@ from avatarsim.render_cams.kinect import kinect_skeleton
 from avatarsim.render_cams.kinect.rig_joints import rig_joints
 from avatarsim.synthesis.movebox.mapping import mapping_for
 from avatarsim.synthesis.movebox.resize import resized
-from avatarsim.synthesis.movebox.retarget import Retargeting, shortest_arc, twist_angle
+from avatarsim.synthesis.movebox.retarget import Retargeting, twist_angle
 from tests.conftest import require
 from tests.synthesis.movebox.conftest import SENSORS
 
@@ -104,16 +104,6 @@ def test_wrist_stabilisation_keeps_the_hands_on_the_forearm(clean_kinect, box_tr
     )
     hands = box_truth.skeleton.indices(["Bip01 L Hand", "Bip01 R Hand"])
     assert np.allclose(local[:, hands], quat.IDENTITY)
-
-
-def test_shortest_arc_turns_u_onto_v_and_handles_opposites():
-    rng = np.random.default_rng(0)
-    u, v = rng.normal(size=(50, 3)), rng.normal(size=(50, 3))
-    v[0] = -u[0]
-    q = shortest_arc(u, v)
-    turned = quat.rotate(q, u)
-    unit = v / np.linalg.norm(v, axis=-1, keepdims=True)
-    assert np.allclose(turned / np.linalg.norm(turned, axis=-1, keepdims=True), unit, atol=1e-9)
 
 
 SPINE_BONES = ("Bip01 Spine", "Bip01 Spine1", "Bip01 Spine2")
