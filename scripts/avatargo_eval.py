@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from avatarsim.scripts.stages.devices import REALISTIC_NOISE
+from avatarsim.render_cams.vr.noise import REALISTIC_NOISE
 from avatarsim.sim.humanoid import humanoid_for
 from avatarsim.sim.plausibility import CONTRACT_KEYS, check_humanoid
 from avatarsim.sim.thresholds import CheckConfig

@@ -10,6 +10,7 @@ from avatarsim.render_cams.vr.attachments import Attachment, OffsetSpread, attac
 from avatarsim.render_cams.vr.dropouts import Dropouts, Occlusion
 from avatarsim.render_cams.vr.faults import NaNSamples, OutOfOrder
 from avatarsim.render_cams.vr.noise import (
+    REALISTIC_NOISE,
     Drift,
     Latency,
     NoiseModel,
@@ -26,6 +27,7 @@ from avatarsim.render_cams.vr.setup import VRSetup
 
 __all__ = [
     "FULL_BODY",
+    "REALISTIC_NOISE",
     "HEADSET_AND_CONTROLLERS",
     "Attachment",
     "Drift",

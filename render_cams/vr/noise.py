@@ -197,3 +197,9 @@ class TimestampJitter:
         return stream.replace(
             timestamps=stream.timestamps + rng.normal(0.0, self.sigma_s, stream.n_samples)
         )
+
+
+# Lighthouse-grade jitter and drift (the defaults above) and one 90 Hz frame of tracking
+# latency; latency first, since it shifts whole samples. What ``noise = "realistic"`` means
+# in scenarios and dataset configs.
+REALISTIC_NOISE = (Latency(seconds=1 / 90), PositionJitter(), RotationJitter(), Drift())

@@ -34,8 +34,8 @@ from threadpoolctl import threadpool_limits
 from avatarsim.avatar_models import quat
 from avatarsim.avatar_models.generator import generate, sample_subject
 from avatarsim.render_cams.vr import FULL_BODY
+from avatarsim.render_cams.vr.noise import REALISTIC_NOISE
 from avatarsim.scripts.benchmarks import BenchRow, best_of
-from avatarsim.scripts.stages.devices import REALISTIC_NOISE
 from avatarsim.synthesis.avatargo import AvatarGo
 from avatarsim.synthesis.avatargo.study import sample_user, setup_for
 from avatarsim.synthesis.avatargo.synthesizer import (

@@ -158,9 +158,8 @@ def mocap_examples(
     """
     from avatarsim.avatar_models.formats import load_motion
     from avatarsim.avatar_models.measure import standing_height
-    from avatarsim.render_cams.vr import HEADSET_AND_CONTROLLERS, VRSetup
+    from avatarsim.render_cams.vr import HEADSET_AND_CONTROLLERS, REALISTIC_NOISE, VRSetup
     from avatarsim.scripts.controllerpose.recording import keypoint_recording
-    from avatarsim.scripts.stages.devices import REALISTIC_NOISE
     from avatarsim.sim.humanoid import humanoid_for
 
     files = mocap_files(folder)

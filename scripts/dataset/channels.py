@@ -40,8 +40,8 @@ from avatarsim.render_cams.fisheye.pose2d import controller_views
 from avatarsim.render_cams.fisheye.rig import camera_poses, controller_cameras, inside_body
 from avatarsim.render_cams.kinect import Kinect
 from avatarsim.render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
+from avatarsim.render_cams.vr.noise import REALISTIC_NOISE
 from avatarsim.scripts.dataset.config import DeviceSetConfig
-from avatarsim.scripts.stages.devices import REALISTIC_NOISE
 from avatarsim.sim.humanoid import Humanoid
 from avatarsim.sim.plausibility import check_humanoid
 

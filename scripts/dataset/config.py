@@ -72,7 +72,7 @@ class DeviceSetConfig:
     Attributes:
         name: the device set's name (part of every sample key; default ``set{k}``).
         vr: headset + controllers at 90 Hz; ``trackers`` adds the Vive trackers.
-        vr_noise: ``"none"`` or ``"realistic"`` (scripts.stages.devices.REALISTIC_NOISE).
+        vr_noise: ``"none"`` or ``"realistic"`` (render_cams.vr.noise.REALISTIC_NOISE).
         fisheye: projected 2D keypoints of the controller cameras.
         fisheye_images: ``"none"``, ``"jpeg"`` or ``"png"``: the cameras' rendered images
             (needs ``fisheye``).

@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 
 from avatarsim.render_cams.kinect import TrackingState, kinect_skeleton
-from avatarsim.render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
+from avatarsim.render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, REALISTIC_NOISE, VRSetup
 from avatarsim.render_cams.vr.dropouts import Dropouts
-from avatarsim.render_cams.vr.noise import Drift, Latency, PositionJitter, RotationJitter
+from avatarsim.render_cams.vr.noise import Latency, PositionJitter
 from avatarsim.scripts.run_context import RunContext
 from avatarsim.scripts.scenario import Scenario
 from avatarsim.synthesis.avatargo.walk_in import walk_in
@@ -17,10 +17,6 @@ METRICS = {
     "vr_valid_frac": "share of valid VR samples over all devices",
     "kinect_tracked_frac": "share of Tracked Kinect joint samples",
 }
-
-# Lighthouse-grade jitter and drift (render_cams.vr.noise defaults) and one 90 Hz frame of
-# tracking latency; latency first, since it shifts whole samples.
-REALISTIC_NOISE = (Latency(seconds=1 / 90), PositionJitter(), RotationJitter(), Drift())
 
 
 def metrics_for(scenario: Scenario) -> set[str]:

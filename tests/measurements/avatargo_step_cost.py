@@ -45,7 +45,7 @@ import avatarsim.avatar_models  # noqa: F401  (the headless GL backend, before a
 from avatarsim.avatar_models.formats import load_motion
 from avatarsim.avatar_models.generator import generate, sample_subject
 from avatarsim.avatar_models.rigs import load_rig
-from avatarsim.scripts.stages.devices import REALISTIC_NOISE
+from avatarsim.render_cams.vr.noise import REALISTIC_NOISE
 from avatarsim.synthesis.avatargo import AvatarGo
 from avatarsim.synthesis.avatargo.study import sample_user, setup_for
 from avatarsim.synthesis.avatargo.walk_in import walk_in

@@ -10,8 +10,8 @@ import pytest
 from avatarsim.avatar_models.formats.bvh import read_bvh
 from avatarsim.avatar_models.measure import standing_height
 from avatarsim.render_cams.vr import HEADSET_AND_CONTROLLERS, VRSetup
+from avatarsim.render_cams.vr.noise import REALISTIC_NOISE
 from avatarsim.scripts.controllerpose.recording import keypoint_recording
-from avatarsim.scripts.stages.devices import REALISTIC_NOISE
 from avatarsim.sim.humanoid import humanoid_for
 from avatarsim.synthesis.base import on_clock
 from avatarsim.synthesis.controllerpose.synthesizer import MODEL_ENV

@@ -8,10 +8,11 @@ from types import SimpleNamespace
 
 import pytest
 
+from avatarsim.render_cams.vr import REALISTIC_NOISE
 from avatarsim.render_cams.vr.dropouts import Dropouts
 from avatarsim.render_cams.vr.noise import Latency, PositionJitter
 from avatarsim.scripts.scenario import DevicesSpec
-from avatarsim.scripts.stages.devices import REALISTIC_NOISE, metrics_for, setup
+from avatarsim.scripts.stages.devices import metrics_for, setup
 
 
 def vr_for(**spec):

@@ -27,7 +27,7 @@ from avatarsim.synthesis.avatargo.study import (
 from avatarsim.synthesis.avatargo.synthesizer import AvatarGo
 from avatarsim.synthesis.avatargo.walk_in import walk_in
 
-# The realistic VR noise of the scenarios (scripts/stages/devices.py REALISTIC_NOISE).
+# The realistic VR noise of the scenarios (render_cams.vr.noise.REALISTIC_NOISE).
 NOISE = (Latency(seconds=1 / 90), PositionJitter(), RotationJitter(), Drift())
 PLACED = ("root", "l_foot", "r_foot")
 """The joints eqs. 2-3 place from a tracker (no IK between tracker and joint)."""
