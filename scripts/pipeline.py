@@ -20,8 +20,8 @@ from avatarsim.scripts.report_html import render_report
 from avatarsim.scripts.results import ThresholdResult, atomic_dir, junit_xml, versions
 from avatarsim.scripts.run_context import RunContext
 from avatarsim.scripts.scenario import Scenario, ScenarioError
+from avatarsim.scripts.scenario_identity import scenario_hash
 from avatarsim.scripts.stages import STAGES, physics
-from avatarsim.scripts.suite.identity import scenario_hash
 from avatarsim.sim.thresholds import ConfigError
 from avatarsim.synthesis.methods import METHODS
 

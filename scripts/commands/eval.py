@@ -678,6 +678,32 @@ def register(app: typer.Typer) -> None:
         """ControllerPose §5.3 accuracy on a dataset's held-out split and on real mocap.
 
         scripts/controllerpose/evaluation.py; writes eval.json and per_joint.png."""
-        from avatarsim.scripts.controllerpose.evaluation import evaluate_command
+        from avatarsim.scripts.controllerpose.data import mocap_files
+        from avatarsim.scripts.controllerpose.evaluation import run_evaluation
+        from avatarsim.synthesis.evaluate import EvaluationError
 
-        evaluate_command(model, data, no_vr_model, frame_stride, out, json_out, mocap, seed)
+        if frame_stride < 1:
+            raise EvaluationError(f"--frame-stride must be at least 1, got {frame_stride}")
+        if mocap is not None:
+            mocap_files(mocap)
+        check_outputs(json_out=json_out, out=out)
+        report = run_evaluation(model, data, out, no_vr_model, frame_stride, mocap, seed=seed)
+        table = Table(title=f"ControllerPose, §5.3 normalised, test: {report['split']}")
+        for column in ("test", "method", "mean cm (SD)", "without hip+torso cm (SD)", "frames"):
+            table.add_column(column)
+        for split, results in (
+            ("dataset", report["results"]),
+            ("real mocap", report["real_mocap"]),
+        ):
+            for name, res in (results or {}).items():
+                table.add_row(
+                    split,
+                    name,
+                    f"{res['mean_cm']:.2f} ({res['sd_cm']:.2f})",
+                    f"{res['limbs_mean_cm']:.2f} ({res['limbs_sd_cm']:.2f})",
+                    str(res["frames"]),
+                )
+        console.print(table)
+        if report["no_vr_increase_pct"] is not None:
+            console.print(f"without VR: {report['no_vr_increase_pct']:+.1f}% (paper: +25.5%)")
+        emit_json(json_out, report)

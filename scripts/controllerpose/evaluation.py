@@ -28,7 +28,6 @@ from avatarsim.scripts.controllerpose.coolmoves_baseline import (
 from avatarsim.scripts.controllerpose.data import (
     load_examples,
     mocap_examples,
-    mocap_files,
     split_streams,
 )
 from avatarsim.scripts.controllerpose.figures import plt, save_png
@@ -42,7 +41,6 @@ from avatarsim.synthesis.controllerpose.evaluate import (
 )
 from avatarsim.synthesis.controllerpose.examples import Examples
 from avatarsim.synthesis.coolmoves import build_database
-from avatarsim.synthesis.evaluate import EvaluationError
 
 MOCAP_SECONDS = 4.0
 PAPER = {"mean_cm": 6.98, "sd_cm": 4.2, "limbs_mean_cm": 8.59, "no_vr_mean_cm": 8.76}
@@ -147,44 +145,3 @@ def run_evaluation(
     plot_per_joint(results, out / "per_joint.png")
     write_json(out / "eval.json", report)
     return report
-
-
-def evaluate_command(
-    model: Path | None,
-    data: Path | None,
-    no_vr_model: Path | None,
-    frame_stride: int,
-    out: Path,
-    json_out: Path | None,
-    mocap: Path | None = None,
-    seed: int = 0,
-) -> None:
-    """``avatarsim eval controllerpose``: checks the options, evaluates, prints a table."""
-    from rich.table import Table
-
-    from avatarsim.scripts.cli_common import check_outputs, console, emit_json
-
-    if model is None or data is None:
-        raise EvaluationError("eval controllerpose needs --model RUN and --data DIR")
-    if frame_stride < 1:
-        raise EvaluationError(f"--frame-stride must be at least 1, got {frame_stride}")
-    if mocap is not None:
-        mocap_files(mocap)
-    check_outputs(json_out=json_out, out=out)
-    report = run_evaluation(model, data, out, no_vr_model, frame_stride, mocap, seed=seed)
-    table = Table(title=f"ControllerPose, §5.3 normalised, test: {report['split']}")
-    for column in ("test", "method", "mean cm (SD)", "without hip+torso cm (SD)", "frames"):
-        table.add_column(column)
-    for split, results in (("dataset", report["results"]), ("real mocap", report["real_mocap"])):
-        for name, res in (results or {}).items():
-            table.add_row(
-                split,
-                name,
-                f"{res['mean_cm']:.2f} ({res['sd_cm']:.2f})",
-                f"{res['limbs_mean_cm']:.2f} ({res['limbs_sd_cm']:.2f})",
-                str(res["frames"]),
-            )
-    console.print(table)
-    if report["no_vr_increase_pct"] is not None:
-        console.print(f"without VR: {report['no_vr_increase_pct']:+.1f}% (paper: +25.5%)")
-    emit_json(json_out, report)

@@ -19,8 +19,8 @@ from rich.table import Table
 from avatarsim.avatar_models.errors import AvatarsimError
 from avatarsim.avatar_models.fileio import write_atomic, write_json
 from avatarsim.scripts.results import atomic_dir, versions
+from avatarsim.scripts.scenario_identity import scenario_hash
 from avatarsim.scripts.suite.discovery import SuiteEntry, load_suite
-from avatarsim.scripts.suite.identity import scenario_hash
 from avatarsim.scripts.suite.index_html import render_index
 from avatarsim.scripts.suite.junit import suite_junit
 from avatarsim.scripts.suite.regression import (

@@ -1,7 +1,7 @@
 """Regression against a stored baseline: which metrics got worse beyond their tolerance.
 
 A baseline is a suite's ``results.json`` (or one scenario's). Metrics are compared only for a
-scenario whose seed and :func:`~scripts.suite.identity.scenario_hash` match the baseline's;
+scenario whose seed and :func:`~scripts.scenario_identity.scenario_hash` match the baseline's;
 a baseline from another scenario version is refused before anything runs. Tolerances come
 from the scenario's ``[regression]`` table (absolute, in the metric's unit) or from defaults
 by metric kind (:data:`DEFAULT_TOLERANCES`). Timings are never compared: they measure the
@@ -18,7 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from avatarsim.scripts.scenario import Scenario, ScenarioError
-from avatarsim.scripts.suite.identity import scenario_hash
+from avatarsim.scripts.scenario_identity import scenario_hash
 
 
 @dataclass(frozen=True)

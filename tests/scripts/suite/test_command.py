@@ -14,7 +14,7 @@ import pytest
 import avatarsim.scripts.stages.synthesis as synthesis_stage
 import avatarsim.scripts.suite.runner as runner
 from avatarsim.scripts.scenario import load_scenario
-from avatarsim.scripts.suite.identity import scenario_hash
+from avatarsim.scripts.scenario_identity import scenario_hash
 from avatarsim.sim import corrupt
 from tests.conftest import require_module
 from tests.scripts.suite.conftest import invoke, write_scenario

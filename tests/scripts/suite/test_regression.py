@@ -7,7 +7,7 @@ import json
 import pytest
 
 from avatarsim.scripts.scenario import ScenarioError, load_scenario
-from avatarsim.scripts.suite.identity import scenario_hash
+from avatarsim.scripts.scenario_identity import scenario_hash
 from avatarsim.scripts.suite.regression import (
     BaselineEntry,
     baseline_file,

@@ -6,7 +6,7 @@ import dataclasses
 import shutil
 
 from avatarsim.scripts.scenario import Threshold, load_scenario
-from avatarsim.scripts.suite.identity import scenario_hash
+from avatarsim.scripts.scenario_identity import scenario_hash
 from tests.scripts.suite.conftest import write_scenario
 
 
