@@ -20,30 +20,26 @@ from avatarsim.synthesis.ik_baseline import attachments_on_upright_rig
 from avatarsim.synthesis.methods import METHODS, MethodInputs, build
 from avatarsim.synthesis.scoring import GROUPS
 
-METRICS = {
-    **{
-        f"{m}_err_cm_{g}": f"{m}: mean body17 error of the {g} group (cm)"
-        for m in METHODS
-        for g in GROUPS
-    },
-    **{
-        f"{m}_hand_corr_min": f"{m}: Pearson r of input vs output hands, worse hand"
-        for m in METHODS
-    },
-    **{
-        f"{m}_skate_cm_s_median": f"{m}: stance foot skating of the output on the humanoid"
-        for m in METHODS
-    },
-    **{
-        f"{m}_penetration_cm_p95": f"{m}: floor penetration of the output on the humanoid"
-        for m in METHODS
-    },
-}
+
+def method_metrics(method: str) -> dict[str, str]:
+    """The metrics (name -> meaning) a run of ``method`` reports."""
+    return {
+        **{
+            f"{method}_err_cm_{g}": f"{method}: mean body17 error of the {g} group (cm)"
+            for g in GROUPS
+        },
+        f"{method}_hand_corr_min": f"{method}: Pearson r of input vs output hands, worse hand",
+        f"{method}_skate_cm_s_median": f"{method}: stance foot skating of its output",
+        f"{method}_penetration_cm_p95": f"{method}: floor penetration of its output",
+    }
+
+
+METRICS = {name: meaning for m in METHODS for name, meaning in method_metrics(m).items()}
 
 
 def metrics_for(scenario: Scenario) -> set[str]:
     methods = scenario.synthesis.methods if scenario.synthesis is not None else ()
-    return {name for name in METRICS if name.split("_", 1)[0] in methods}
+    return {name for m in methods for name in method_metrics(m)}
 
 
 def database_takes(ctx: RunContext) -> list[Motion]:
