@@ -96,9 +96,9 @@ def assign_splits(groups: list[str], fractions: dict[str, float], seed: int) -> 
     groups go where is a permutation drawn from ``seed``.
     """
     n = len(groups)
-    wanted = np.array([fractions[s] for s in SPLITS]) * n
+    wanted = np.array([fractions.get(s, 0.0) for s in SPLITS]) * n  # a split left out: 0
     counts = np.floor(wanted).astype(int)
-    positive = np.array([fractions[s] > 0 for s in SPLITS])
+    positive = wanted > 0
     if n >= positive.sum():
         counts = np.where(positive & (counts == 0), 1, counts)
     while counts.sum() > n:  # the minimum of one took groups from the largest split

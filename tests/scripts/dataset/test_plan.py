@@ -25,6 +25,14 @@ def test_every_group_gets_one_split_in_proportion(n):
     )
 
 
+@pytest.mark.parametrize("splits", [{"train": 1.0}, {"train": 0.5, "test": 0.5}])
+def test_a_split_left_out_of_the_config_gets_no_samples(splits):
+    config = from_dict({**TINY, "splits": splits})
+    planned = Counter(s.split for s in plan_samples(config))
+    assert set(planned) == set(splits)  # the others are empty, not an error
+    assert sum(planned.values()) == len(plan_samples(from_dict(TINY)))
+
+
 def test_plan_is_deterministic_and_held_out_subjects_stay_out_of_train():
     config = from_dict(TINY)
     samples = plan_samples(config)
