@@ -11,8 +11,8 @@ Rows, each against a baseline run in this process:
 - ``dataset_ray[2 vs 1 workers]``: samples/s with ``--executor ray`` and 2 workers; baseline:
   1 worker, on one local Ray instance started once (its start-up is not timed). The issue
   aims at 1.8x or more; the machine's free cores bound it.
-- ``dataset_read[DataLoader 2 workers]``: samples/s streamed from the shards through a torch
-  ``DataLoader`` with 2 workers; baseline: no worker processes.
+- ``dataset_read[DataLoader 2 workers]``: samples/s streamed from the shards through
+  ``ShardDataset.loader`` (a torch ``DataLoader``) with 2 workers; baseline: no workers.
 """
 
 from __future__ import annotations
@@ -56,16 +56,17 @@ def samples_per_s(config: DatasetConfig, folder: Path, **executor) -> float:
 
 
 def _read_rate(root: Path, workers: int, epochs: int) -> float:
-    """Samples/s over ``epochs`` passes, worker start-up included once (persistent
-    workers, as a training loop keeps them)."""
-    from torch.utils.data import DataLoader
-
+    """Samples/s over ``epochs`` passes of :meth:`ShardDataset.loader`, worker start-up
+    included once (persistent workers, as a training loop keeps them)."""
     from avatarsim.scripts.dataset.torch_dataset import ShardDataset
 
     data = ShardDataset(root, "train", shuffle_buffer=8, seed=0)
-    loader = DataLoader(data, batch_size=None, num_workers=workers, persistent_workers=workers > 0)
+    loader = data.loader(num_workers=workers)
     start = time.perf_counter()
-    n = sum(1 for _ in range(epochs) for _ in loader)
+    n = 0
+    for epoch in range(epochs):
+        data.set_epoch(epoch)
+        n += sum(1 for _ in loader)
     return n / (time.perf_counter() - start)
 
 

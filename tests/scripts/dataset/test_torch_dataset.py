@@ -47,3 +47,37 @@ def test_samples_are_tensors_with_their_description(tiny_dataset):
     sample = next(iter(ShardDataset(tiny_dataset, "val")))
     assert isinstance(sample["body17"], torch.Tensor) and sample["body17"].shape[1:] == (17, 3)
     assert sample["json"]["split"] == "val" and sample["json"]["key"] == sample["__key__"]
+
+
+def test_loader_workers_give_the_samples_one_process_reads(tiny_dataset):
+    alone = {s["__key__"]: s for s in ShardDataset(tiny_dataset, "train")}
+    loader = ShardDataset(tiny_dataset, "train").loader(num_workers=2)
+    read = list(loader)
+    assert sorted(s["__key__"] for s in read) == sorted(alone) and len(loader) == len(alone)
+    for sample in read:
+        expected = alone[sample["__key__"]]
+        assert sample.keys() == expected.keys()
+        for name, value in sample.items():
+            if isinstance(value, torch.Tensor):
+                assert value.dtype == expected[name].dtype and torch.equal(value, expected[name])
+            else:
+                assert value == expected[name]
+
+
+def test_set_epoch_reaches_persistent_workers(tiny_dataset):
+    """The epoch's order as fresh workers read it, from workers started an epoch earlier."""
+
+    def fresh(epoch):
+        dataset = ShardDataset(tiny_dataset, "train", shuffle_buffer=4, seed=3)
+        dataset.set_epoch(epoch)
+        return _keys(dataset.loader(num_workers=2))
+
+    dataset = ShardDataset(tiny_dataset, "train", shuffle_buffer=4, seed=3)
+    persistent = DataLoader(dataset, batch_size=None, num_workers=2, persistent_workers=True)
+    loader = dataset.loader(num_workers=2)
+    orders = []
+    for epoch in range(3):
+        dataset.set_epoch(epoch)
+        orders.append(_keys(loader))
+        assert orders[-1] == fresh(epoch) == _keys(persistent)
+    assert len({tuple(o) for o in orders}) > 1
