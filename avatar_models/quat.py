@@ -91,7 +91,7 @@ _YZX, _ZXY = np.array([1, 2, 0]), np.array([2, 0, 1])
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``a x b`` over the last axis ``(..., 3)``: ``(ay bz - az by, az bx - ax bz,
     ax by - ay bx)``, by permuted components (np.cross's moveaxis set-up costs more than
-    the arithmetic on a step's few vectors; it was most of AvatarGo's goals)."""
+    the arithmetic on a step's few vectors, and would be most of AvatarGo's goals)."""
     # take, not a[..., _YZX]: the same gather without advanced indexing's set-up.
     return a.take(_YZX, axis=-1) * b.take(_ZXY, axis=-1) - a.take(_ZXY, axis=-1) * b.take(
         _YZX, axis=-1
@@ -155,8 +155,8 @@ def from_matrix(m: np.ndarray, orthonormal: bool = False) -> np.ndarray:
 # -- the hot path without scipy ---------------------------------------------------------
 # ``step()`` of a synthesiser converts about twenty joints per 90 Hz sample, and building a
 # ``Rotation`` costs tens of microseconds of Python-level set-up per call, more than the
-# arithmetic itself (three Euler round trips were a third of CoolMoves' per-step time). The
-# formulas are the textbook ones and are checked against scipy in the tests.
+# arithmetic itself (through scipy, three Euler round trips would take a third of a CoolMoves
+# step). The formulas are the textbook ones and are checked against scipy in the tests.
 #
 # Euler convention (scipy's upper-case, intrinsic): order ``"abc"`` means
 # ``R = R_a(alpha) R_b(beta) R_c(gamma)``, angles ``(alpha, beta, gamma)``; only Tait-Bryan

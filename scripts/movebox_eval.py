@@ -1,5 +1,5 @@
 """``avatarsim eval movebox``: MoveBox's retargeting, roll recovery, smoothing, loops and lip
-sync measured against ground truth, and the physics of its output (issue 14, item 6).
+sync measured against ground truth, and the physics of its output.
 
 Per take (built-in activities, or one real clip per mocap source) and per sensor (Kinect V2,
 Azure Kinect):
@@ -7,7 +7,7 @@ Azure Kinect):
 - ``retarget_err_cm``: mean body17 error of the retargeting stage alone, at the sensor's
   30 Hz, over frames whose body17-driving joints are all Tracked; ``noise_free`` (exact
   joints) and ``noisy`` (the sensor's skeleton noise) beside ``kinect_err_cm``, the error
-  of the noisy Kinect joints themselves (the sensor noise the issue's aim is relative to).
+  of the noisy Kinect joints themselves (the sensor noise the retargeting error is judged against).
 - ``roll_err_deg``: mean absolute twist of the limb bones (upper arms, forearms, thighs,
   calves) between truth and retargeting, noise-free, with roll recovery (``rest``) and with
   the sensor's roll (``sensor``); built-in takes only (the truth must be on the avatar rig).

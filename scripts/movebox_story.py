@@ -1,4 +1,4 @@
-"""The storytelling scene of ``avatarsim eval movebox`` (issue 14, item 5; MoveBox §III-B):
+"""The storytelling scene of ``avatarsim eval movebox`` (MoveBox §III-B):
 actors recorded one at a time through a simulated Kinect, played back together on avatars of
 other sizes, one speaking from an audio file. Writes ``story.mp4`` (imageio) and
 ``story.xml`` (MJCF; ``python -m mujoco.viewer --mjcf story.xml``, then step the keyframes).

@@ -86,11 +86,10 @@ advances by ``stepSpeed * dt``, so a step lasts ``1 / stepSpeed`` s, and each st
 speed uniformly from ``[stepSpeed, 1.5 stepSpeed]``, i.e. 0.22-0.33 s per step."""
 MAX_SWING_S = 1.0 / (1.5 * VRIK_STEP_SPEED)
 """Longest swing of one foot: a step takes ``min(1 / cadence, MAX_SWING_S)``, VRIK's quickest
-step (0.222 s, :data:`VRIK_STEP_SPEED`; deterministic, where VRIK draws at random). Not tuned:
-it replaced 0.2 s, which had been chosen on the generator's cross-subject test folds (0.4 s, a
-biomechanical swing time, left a running body's feet behind: 23.8 vs 14.8 cm full-body on
-run). Quick swings are what one-foot-at-a-time stepping needs to keep up without a flight
-phase."""
+step (0.222 s, :data:`VRIK_STEP_SPEED`; deterministic, where VRIK draws at random), taken
+from VRIK rather than tuned on the generator's test folds. Quick swings are what
+one-foot-at-a-time stepping needs to keep up without a flight phase: a biomechanical swing
+time (0.4 s) leaves a running body's feet behind."""
 STEP_HEIGHT_M = (0.05, 0.1, 0.35)
 """Apex of the foot's arc above its planted height: ``clip(b v, lo, hi)`` as ``(lo, b, hi)``
 (our choice: about 0.13 m walking, 0.33 m running, the swing-foot heights of typical gait)."""

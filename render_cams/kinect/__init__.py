@@ -1,5 +1,5 @@
 """Simulated Kinect V2 and Azure Kinect: depth with a published noise model, body-index maps
-and 30 Hz skeleton streams (issue 4, item 6).
+and 30 Hz skeleton streams.
 
 - :mod:`.sensors`: depth modes (size, field of view, range) with sources.
 - :mod:`.noise`: axial/lateral depth noise, flying pixels, invalid pixels.

@@ -1,6 +1,6 @@
 """Fisheye camera benchmarks: rendered frames/s per camera and keypoint projection rate.
 
-Targets (issue 4): at least 25 fisheye frames/s per camera at 640x480 on one core and 200k
+Our targets: at least 25 fisheye frames/s per camera at 640x480 on one core and 200k
 body17-frames/s of keypoint projection; the baseline column is the sensor's real 30 fps
 (ControllerPose §4.1 cameras) and, for projection, ``cv2.fisheye.projectPoints``.
 """

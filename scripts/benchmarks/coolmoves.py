@@ -10,7 +10,7 @@ the thread's CPU time of each step (``time.thread_time_ns``), per frame the leas
 waiting for a core, and one pass's CPU time still swings with what shares the core (its p99
 moved between 0.77 and 1.55 ms over runs of the same code at load 3); the least of a few
 passes is what the frame's step costs. The note gives one pass's CPU p99 and the load
-average. Our aim for a step is a p99 under 0.75 ms (issue 15).
+average. Our aim for a step is a p99 under 0.75 ms.
 Baselines are the paper's (CoolMoves §3.1.5, a Core i7-7700HQ): the Python backend ran at
 152 Hz (6.6 ms a frame) and the mixture-model variant at 44 Hz (22.7 ms); a VR frame at
 90 Hz leaves 11.1 ms.
@@ -36,7 +36,7 @@ PAPER_BACKEND_MS = 1000.0 / 152.0
 PAPER_GMM_MS = 1000.0 / 44.0
 FRAME_BUDGET_MS = 1000.0 / 90.0
 STEP_AIM_MS = 0.75
-"""Our aim for a step's p99 (issue 15), a fifteenth of the 90 Hz frame."""
+"""Our aim for a step's p99, a fifteenth of the 90 Hz frame."""
 CPU_PASSES = 3
 """Passes over the stream whose least CPU time per frame the CPU rows report."""
 
@@ -99,7 +99,7 @@ def run(quick: bool = False, mocap: Path | None = None) -> list[BenchRow]:
                 "ms",
                 float(np.percentile(cpu_ms.min(axis=0), 99)),
                 STEP_AIM_MS,
-                "our aim (issue 15)",
+                "our aim",
                 f"{note}, per frame the least over {len(cpu_ms)} pass(es), p50 "
                 f"{np.percentile(cpu_ms.min(axis=0), 50):.3f} ms; one pass's p99 "
                 f"{np.percentile(cpu_ms[0], 99):.3f} ms; {load}",

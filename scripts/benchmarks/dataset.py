@@ -1,4 +1,4 @@
-"""Dataset generation and reading throughput (issue 11).
+"""Dataset generation and reading throughput.
 
 Rows, each against a baseline run in this process:
 
@@ -9,8 +9,8 @@ Rows, each against a baseline run in this process:
 - ``dataset_generate[images]``: the same with fisheye JPEGs and Kinect v2 depth every third
   frame at half size; baseline: keypoints only (the ratio is what images cost).
 - ``dataset_ray[2 vs 1 workers]``: samples/s with ``--executor ray`` and 2 workers; baseline:
-  1 worker, on one local Ray instance started once (its start-up is not timed). The issue
-  aims at 1.8x or more; the machine's free cores bound it.
+  1 worker, on one local Ray instance started once (its start-up is not timed). Our aim
+  is 1.8x or more; the machine's free cores bound it.
 - ``dataset_read[DataLoader 2 workers]``: samples/s streamed from the shards through
   ``ShardDataset.loader`` (a torch ``DataLoader``) with 2 workers; baseline: no workers.
 """

@@ -1,4 +1,4 @@
-"""MoveBox step latency (issue 14): the streaming ``step`` that takes in a new 30 Hz Kinect
+"""MoveBox step latency: the streaming ``step`` that takes in a new 30 Hz Kinect
 frame (retargeting, tracking-state rules, smoothing), per sensor, next to the IK baseline's
 ``step`` on the same VR stream, timed in the same process.
 

@@ -19,8 +19,8 @@ View kinds:
 - ``third person``: a pinhole camera 3 m in front of the body
   (:mod:`render_cams.third_person`), the control.
 
-Clips: the built-in ControllerPose study activity (from 10 s, as issue measurements render
-it), a built-in walk, and one real clip of each source in the mocap folder (``bench --mocap``:
+Clips: the built-in ControllerPose study activity (from 10 s), a built-in walk, and one
+real clip of each source in the mocap folder (``bench --mocap``:
 CMU basketball 06_06 from 1 s, after its T-pose; Bandai ``punch_normal_001``, hands in front of
 the face), each seen through the simulated cameras. The time per image is BlazePose's on one core
 (the process pinned to one CPU), on a 640 x 480 image with and without a person.

@@ -1,4 +1,4 @@
-"""CoolMoves from the VR stream alone, as a baseline of ``eval controllerpose`` (issue 12).
+"""CoolMoves from the VR stream alone, as a baseline of ``eval controllerpose``.
 
 The registry's ``coolmoves`` (CoolMoves §3.1 as the paper describes it: headset and two
 controllers, no cameras) with a database of the dataset's *training split* only: the motions

@@ -1,4 +1,4 @@
-"""Synthetic datasets: ``avatarsim dataset generate|info|verify|preview`` (issue 11).
+"""Synthetic datasets: ``avatarsim dataset generate|info|verify|preview``.
 
 One concept per module:
 

@@ -13,10 +13,10 @@ ankle and toe sites at their heights in the rest pose, which stands flat-footed 
 on the other frames no foot site goes below that height (toes dug into the floor at toe-off
 would throw the simulated body up). UHC and PhysDiff clean contact the same way: feet in
 stance are put on the ground before physics. Three more repairs make a reference the
-simulated feet can walk (Bandai walks: the plain controller's mean time upright from five start
-frames went from 0.8 to 2.7 s): the source's standing foot pitch (ankle to toe; Bandai 40 deg
-down, the humanoid 17) is matched before the IK (:func:`match_foot_pitch`), else every frame
-tips the foot toes-down; toe joints bend where their box would dip into the floor
+simulated feet can walk (Bandai walks: the plain controller's mean time upright from five
+start frames is 2.7 s with them, 0.8 s without): the source's standing foot pitch (ankle to
+toe; Bandai 40 deg down, the humanoid 17) is matched before the IK (:func:`match_foot_pitch`),
+else every frame tips the foot toes-down; toe joints bend where their box would dip into the floor
 (:func:`lift_toes`); and swinging feet keep their soles :data:`SWING_CLEARANCE_M` up
 (:func:`clear_swing_feet`), since the humanoid's toe box reaches 7 cm beyond the source's
 toe joint and would drag on the floor and trip the body.

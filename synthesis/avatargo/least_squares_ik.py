@@ -4,7 +4,7 @@
 full-body solver each frame); this repository stands in with mink on the humanoid
 (:class:`~avatar_models.body.ik.HumanoidIK`: one QP per iteration, joint ranges as
 inequality constraints). Built per tick, that QP costs ~1.6 ms per iteration on one core
-(mink's task bookkeeping and the dense QP), over the 1 ms aim of a whole tick (issue 13).
+(mink's task bookkeeping and the dense QP), over our 1 ms aim for a whole tick.
 
 :class:`LeastSquaresIK` minimises the same objective (the same frame tasks, costs, posture
 term, Levenberg-Marquardt and step damping, :class:`~avatar_models.body.ik.IKSettings`) in

@@ -123,9 +123,7 @@ pose meets every goal (at 0.03: under 1 cm). Tuned on wave (seeds 0, 2) and box 
 So soft a wrist turn leaves the wrist up to ~6 deg off its goal, and the palm, 8 cm out,
 up to 9 mm off the controller; hence each tick after the first aims the wrist at the
 controller less the palm offset turned by the wrist's solved rotation (the last tick's),
-not the goal's: the palm then sits on the controller whatever turn the IK settles on
-(study_run, 2 s, mean palm distance 0.4 / 5.5 / 0.1 / 0.24 cm before, 0.22 / 0.24 / 0.21 /
-0.13 after on wave 0, box 1, walk 2, wave 3)."""
+not the goal's: the palm then sits on the controller whatever turn the IK settles on."""
 ITERATIONS_PER_TICK = 2
 """QP iterations per 90 Hz tick after the first (warm start; the goals move < 2 cm a tick)."""
 FIRST_ITERATIONS = 40

@@ -14,9 +14,9 @@
   (1 for an exact match, 1/2 at the threshold, never 0: a heavy-tailed kernel whose
   half-width is the threshold); a hand's confidence is the weighted mean over its matches; a
   limb joint has its hand's confidence, every other joint the mean of both; the global match
-  weight is the mean over all joints. Before, the likelihood was ``1 - d / t`` floored at 0,
-  so an input farther than the threshold from every database window (2 cm tracking jitter,
-  real mocap against a generated database) got weight 0 and the output froze in its pose.
+  weight is the mean over all joints. A kernel that reaches 0 (``1 - d / t`` floored at 0)
+  would give an input farther than the threshold from every database window (2 cm tracking
+  jitter, real mocap against a generated database) weight 0 and freeze the output in its pose.
 - The trunk and legs weigh the two hands' matches by the hands' confidences, so that a hand
   with poor matches (or untracked) leaves them to the other.
 

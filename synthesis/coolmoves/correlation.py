@@ -13,8 +13,8 @@ foot's, signed; a trial's score is the mean over the four hand-foot pairs.
 Why this one. It reproduces the paper's observations on CMU, its data source
 (``tests/measurements/hand_foot_correlation.py`` prints the table): basketball 0.77 and
 climbing 0.71 on average (paper: above 0.5), swimming 0.13 (paper: below 0.2, SD 0.18) with
-one of the two swim clips removed at 0.1 (paper: nearly 60%). The readings it was measured
-against fail there: the mean of per-axis ``|r|`` (the previous filter) gives basketball 0.27
+one of the two swim clips removed at 0.1 (paper: nearly 60%). The other readings fail
+there: the mean of per-axis ``|r|`` gives basketball 0.27
 and swimming 0.31 and removes no swim trial, nor any trial of smoothed independent noise;
 per-axis signed r, velocities, or series centred per axis give basketball 0.06-0.26.
 What makes it work: a flattened series also varies between its X, Y and Z blocks, so the

@@ -30,10 +30,10 @@ from avatarsim.synthesis.coolmoves.blend import inverse_distance_weights
 K_NEIGHBOURS = 5
 """Matches per hand, as in the paper's Fig. 3 ("top 5 matches")."""
 MAX_DISTANCE = 0.6
-"""Neighbourhood distance threshold (our choice; the paper gives none). It was first chosen
-on the built-in generator's cross-subject evaluation, i.e. seeing the test folds; the
-protocols no longer use it as such (:func:`synthesis.evaluate.validation.choose_max_distance`
-picks from a grid around it on training data only)."""
+"""Neighbourhood distance threshold (our choice; the paper gives none), chosen on the built-in
+generator's cross-subject evaluation, i.e. seeing its test folds; so the protocols do not use
+it as such (:func:`synthesis.evaluate.validation.choose_max_distance` picks from a grid
+around it on training data only)."""
 
 
 SIDE_SEPARATION = 1e6

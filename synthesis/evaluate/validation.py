@@ -25,8 +25,8 @@ from avatarsim.synthesis.scoring import score_run
 
 DISTANCE_GRID = (0.3, 0.6, 1.2)
 """Candidate thresholds, in the units of :mod:`synthesis.coolmoves.features` (metres over
-one window's positions, velocities and accelerations): half, once and twice the value the
-built-in evaluation settled on before this module (0.6)."""
+one window's positions, velocities and accelerations): half, once and twice the default
+:data:`synthesis.coolmoves.knn.MAX_DISTANCE` (0.6)."""
 
 
 def validation_split(train: Sequence[Trial], protocol: str) -> tuple[list[Trial], list[Trial]]:

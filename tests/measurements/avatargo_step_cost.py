@@ -1,4 +1,4 @@
-"""What one AvatarGo ``step()`` costs, and whether a change kept its output (issue 13).
+"""What one AvatarGo ``step()`` costs, and whether a change kept its output.
 
 The inputs are ``avatarsim bench avatargo``'s (a sampled user waving for 4 s, six devices,
 realistic VR noise) and, where the real mocap is present, a Bandai dataset-2 right-hand wave
@@ -17,21 +17,8 @@ as the avatar. Both with exact and with fixed offsets, the default (analytic) so
 The script uses only the synthesiser's public API, so it runs on another checkout too:
 ``PYTHONPATH=/path/to/main python <this file> outputs main.npz``.
 
-Measured on 2026-12-02, branch ``agolat`` against 4145123 (issue 13's 1 ms aim): ``outputs``
-+ ``compare``: every array equal to the bit on both inputs (step against run as before:
-1.95e-14 / 5.08e-12 in the bench input's rotations, 0 on Bandai). ``timing 5``
-alternated four times on a 2-core machine at load 3.9-4.8 (ms of CPU per step, best of 5
-per frame): base p50 0.95, 0.72, 0.70, 1.09 / branch 0.63, 0.66, 0.63, 0.65. Where a tick
-goes (a statement-level timer, us, load ~4): goals 60-85 (the trackers' joint poses 44),
-the analytic solve 410-440 of which the two-bone solve 160-190, the palm distances 10,
-the devices' normalisation 17, the fingers 13. About a third of the tick is in
-:mod:`avatar_models.quat` (10 ``mul``, 6 ``cross``, 2 ``from_axis_angle``, 4
-``unit_to_matrix``): ``mul`` summing its four rows by one ``np.add.reduce(axis=-2)`` and
-``cross`` gathering by ``take`` give the same bits here, at ~5 us less a call each (applied
-in e730313; ``compare``: every array still equal to the bit).
-
-Merged main (e730313), ``avatarsim bench avatargo`` three times at load 0.47-0.59 (no other
-job): analytic step p50 0.51-0.53 ms, p99 0.58-0.68 ms wall, CPU p99 0.57-0.67 ms.
+Readings of past changes are in the commit log
+(``git log -p -- tests/measurements/avatargo_step_cost.py``).
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Paper-mode CoolMoves against the positions-only reference
 (:mod:`tests.measurements.coolmoves_reference`), one difference at a time, on Bandai
-dataset-2 cross-trial with classes by activity (issue 15).
+dataset-2 cross-trial with classes by activity.
 
     PYTHONPATH=. .venv/bin/python -m tests.measurements.coolmoves_ablation [MOCAP_DIR] [CLASS...]
 
@@ -13,8 +13,8 @@ to the truth (head-relative body17 joints, knowing the truth, no alignment), per
 (:mod:`tests.measurements.coolmoves_floors` has the other floors). Variants marked
 "diagnostic" or "beyond" are not the paper's method.
 
-Measured 2026-12-02 (210 trials, 30 folds, one job: 18 min wall, 7 min CPU, on base 4145123
-plus the own-hand option; the 2-heading row after the pelvis fix, same folds and thresholds):
+Measured (210 trials, 30 folds, one job: 18 min wall, 7 min CPU; the 2-heading row with the
+same folds and thresholds):
 
     variant             full cm  hands cm  hand r
     paper                  3.80      4.36   0.897
@@ -35,7 +35,7 @@ raise-up-right-hand 1.83, run 8.41, walk 4.85, walk-turn-left 3.89, walk-turn-ri
 wave-both-hands 6.04, wave-left-hand 2.47, wave-right-hand 2.04 (floor: 2.23, 1.47, 1.22,
 4.66, 3.51, 3.06, 3.10, 5.09, 1.47, 1.24).
 
-Where the error is, beyond the issue's aim of 2.5 cm full and 2.8 cm hands:
+Where the error is, beyond our aim of 2.5 cm full and 2.8 cm hands:
 
 - The hand-foot filter (§3.1.2) keeps 6 of 14 training trials of wave-both-hands and 10 of
   raise-up-both-hands; its score follows where the hands are held more than how they move:
@@ -43,7 +43,7 @@ Where the error is, beyond the issue's aim of 2.5 cm full and 2.8 cm hands:
   0.63-0.65, normal (2-8 cm above) 0.16-0.34, active, exhausted, masculine and youthful
   (6-19 cm above) -0.29 to 0.07 and are dropped. Keeping every trial: wave-both-hands
   6.04 -> 2.14 cm full (hands 11.7 -> 2.9), raise-up-both-hands 2.81 -> 2.00; all classes
-  3.80 -> 3.33 full, 4.36 -> 3.35 hands. The filter's reading is issue 15 item 2's.
+  3.80 -> 3.33 full, 4.36 -> 3.35 hands.
 - The heading: run and walk take 2 go the other way along X to takes 1 and 3 of every
   style; the features are head-relative, not turned with the head (§3.1.2), so take 2 finds
   other styles at its own heading: run take 2 14.8 cm full, walk take 2 8.9 cm (takes 1 and
@@ -61,19 +61,17 @@ Where the error is, beyond the issue's aim of 2.5 cm full and 2.8 cm hands:
 - The window grid (a pose every 44 ms) costs the floor 0.03-0.26 cm full body.
 - ``--db-headings 2`` (every training trial also turned by 180 deg, beyond the paper) gives
   take 2 its own styles: run 8.41 -> 4.34, walk 4.85 -> 2.49 (the other classes within
-  0.12 cm). The row is with the copies turned at the pelvis
-  (:func:`synthesis.evaluate.folds.database_for`); turned at Bandai's static root
-  ``joint_Root``, as before, a copy differed from a recording facing the same way by 180 deg
-  in the root and -180 deg in the hips, blends of the two turned the body anywhere, and the
-  row read 5.52 / 6.79 / 0.838 (run 17.95, walk 12.36).
+  0.12 cm). The copies are turned at the pelvis
+  (:func:`synthesis.evaluate.folds.database_for`): turned at Bandai's static root
+  ``joint_Root``, a copy would differ from a recording facing the same way by 180 deg in the
+  root and -180 deg in the hips, and blends of the two would turn the body anywhere.
 
 Together (one-off runs, same folds and thresholds): filter off and 2 headings 2.71 / 2.83 /
-0.919; with own-hand alignment too 2.61 / 2.77 / 0.925, the hands and hand r within the
-issue's aim, full body 0.11 cm above it: run 4.23, walk-turn-left 4.09, walk-turn-right
+0.919; with own-hand alignment too 2.61 / 2.77 / 0.925, the hands and hand r within our
+aim, full body 0.11 cm above it: run 4.23, walk-turn-left 4.09, walk-turn-right
 3.89 cm remain (their floors 4.66, 3.06, 3.10; yaw-free 3.02, 2.65, 2.65).
 
-History: before the KD-tree fallback of issue 15 the paper row read 3.84 / 4.62 / 0.891; no
-single switch of the pipeline (threshold, limits, EWMA, scaling) moves full body by more than
+No single switch of the pipeline (threshold, limits, EWMA, scaling) moves full body by more than
 0.04 cm, and the reference is within 0.05 cm full of paper mode.
 """
 

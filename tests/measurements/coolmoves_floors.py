@@ -1,5 +1,5 @@
-"""Floors of any single-pose pick for CoolMoves on Bandai dataset-2, cross-trial by activity
-(issue 15): per test frame, the training pose nearest to the truth, knowing the truth.
+"""Floors of any single-pose pick for CoolMoves on Bandai dataset-2, cross-trial by activity:
+per test frame, the training pose nearest to the truth, knowing the truth.
 
     PYTHONPATH=. .venv/bin/python -m tests.measurements.coolmoves_floors [MOCAP_DIR] [TAKE]
 
@@ -15,7 +15,7 @@ each either as stored ("as is") or with both sides turned to face +X first ("yaw
 heading from the hip line; the pick is turned back to the truth's heading). Prints the mean
 over classes of full-body and hand error (cm), then per class.
 
-Measured 2026-12-02 (210 trials, 30 folds; ``ends as is body`` is the ablation's
+Measured (210 trials, 30 folds; ``ends as is body`` is the ablation's
 single-pose floor):
 
     floor                      full cm  hands cm

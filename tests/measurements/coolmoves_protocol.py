@@ -1,5 +1,5 @@
 """Paper-mode CoolMoves on the same Bandai dataset-2 test clips under three databases
-(issue 15: is the gap to a leave-one-clip-out reimplementation the protocol?).
+(is the gap to a leave-one-clip-out reimplementation the protocol?).
 
     PYTHONPATH=. .venv/bin/python -m tests.measurements.coolmoves_protocol [MOCAP_DIR] [STYLE...]
 
@@ -16,7 +16,7 @@ clip is seen), paper mode, and the positions-only reference and the single-pose 
 :mod:`tests.measurements.coolmoves_ablation` beside it. Prints per database the mean over
 test clips of full-body and hand error (cm) and mean hand correlation.
 
-Measured 2026-12-02 (post-fix code, threshold 0.6; take 1 of the 10 activities; full cm /
+Measured (threshold 0.6; take 1 of the 10 activities; full cm /
 hands cm / hand r). Style normal (10 clips):
 
     database     paper               no threshold        reference w=0.5     single-pose floor

@@ -1,4 +1,4 @@
-"""What one CoolMoves ``step()`` costs, and whether a change kept its output (issue 15).
+"""What one CoolMoves ``step()`` costs, and whether a change kept its output.
 
 The input is ``avatarsim bench coolmoves``'s (the generator's five Table-1 activities for
 four subjects, a held-out subject's boxing through the default ``VRSetup``) and, where the
@@ -15,30 +15,8 @@ real mocap is present, a Bandai dataset-2 walk driving a database of three other
 The script uses only the registry and the synthesiser contract, so it runs on another
 checkout too: ``PYTHONPATH=/path/to/main python <this file> outputs main.npz``.
 
-Measured on 2026-12-02 on a shared 2-core machine (load 3.1-3.4), ``timing 7`` twice on
-each checkout, back to back, main at 41759a9 against branch ``cmfast`` (ms of CPU per step;
-``outputs`` + ``compare``: every array equal to the bit, step equal to run on both inputs):
-
-                      main                          branch
-                      best of 7 p50/p99   every p99  best of 7 p50/p99   every p99
-    coolmoves         1.01-1.02/1.20-1.26 1.98-2.08  0.59-0.60/0.69      0.77-0.95
-    coolmoves+arm-ik  1.70-1.73/1.88-1.95 3.62-3.69  0.97-0.98/1.05-1.08 1.12-1.20
-
-Then branch ``cmtail`` against bb0e4a0 (the headset hold of a step without the batch's
-running maximum, 23 -> 5 us; no NaN-free hand copy in paper mode): every array equal to the
-bit again. ``timing 7`` interleaved, base/branch twice, at load 3.6-4.1 (ms of CPU): best of
-7 p50 0.72, 0.69 / 0.66, 0.67, p99 1.09, 0.92 / 0.81, 1.05: the machine's load moves the
-numbers more than the change does. Per block, best of 5 per frame (function wrappers, load
-3.4-3.8, us at p50/p99): KD-tree search with its thresholding 182/300, blend 63/83, group
-weights 45/52, alignment 40/45, joint limits 82/108 (the Euler round trip on 21 joints),
-head-chain placement 71/95 (forward kinematics along 7 joints), EWMA 19/23.
-
-Then branch ``cmlat`` against 4145123 (the KD-tree's data stored in leaf order,
-:func:`synthesis.coolmoves.knn.leaf_ordered_tree`): every array equal to the bit again.
-``timing 7`` interleaved, base/branch twice, at load 2.5-3.0 (ms of CPU, best of 7):
-coolmoves p50 0.68, 0.66 / 0.62, 0.64, p99 1.13, 1.07 / 0.81, 0.80; coolmoves+arm-ik
-p99 1.41, 1.45 / 1.22, 1.19. Another helper shared the two cores; at load 4.1-4.6 the
-same runs swung from 0.86 to 1.21 ms at p99 for either checkout.
+Readings of past changes are in the commit log
+(``git log -p -- tests/measurements/coolmoves_step_cost.py``).
 """
 
 from __future__ import annotations

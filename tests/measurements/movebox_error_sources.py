@@ -1,5 +1,5 @@
-"""Where MoveBox's body17 error comes from, per real clip (the CMU-against-Bandai finding of
-issue 14: 21-27 cm on CMU runs against 3.5-7 cm on the first Bandai clips).
+"""Where MoveBox's body17 error comes from, per real clip (why CMU runs score several times
+worse than the first Bandai clips).
 
     PYTHONPATH=. .venv/bin/python -m tests.measurements.movebox_error_sources \
         [SENSOR] CLIP.bvh...
@@ -37,8 +37,8 @@ Where it enters: (1) ``all`` against ``tracked``: a performer leaving the view o
 (running, a basketball drive, a long walk) is NotTracked and MoveBox holds the pose where
 they left, so the error grows with the distance run (102_01: 99 cm, 8.7 cm while tracked);
 (2) ``tracked`` against ``noisy``: at 2.6-3.6 m/s the 30 Hz sample-and-hold costs 1-3 cm (the
-paper smooths rotations only; before the root stopped being smoothed too, now the option
-``smooth_root``, its ~50 ms lag cost 5-9 cm: 16_35 tracked 12.0, 35_17 13.4, 09_01 15.6);
+paper smooths rotations only; smoothing the root too, the option ``smooth_root``, lags it
+~50 ms and costs 5-9 cm: 16_35 tracked 12.0, 35_17 13.4, 09_01 15.6);
 (3) ``clean``: the avatar's proportions against CMU's (4-5.5 cm; 3-4 on Bandai with the same
 height-only resize, unif); (4) ``kin``: the sensor's joint noise, 2-3.3 cm everywhere.
 (b1/b2: Bandai dataset-1/2 ``run_normal_001``, ``walk_normal_001``, and the first clip of

@@ -1,5 +1,5 @@
-"""Bad input from the campaign of issue 9 §5: each group exits 2 with one accurate line on
-stderr, is checked before any work, writes nothing half-way and never deletes a user's file."""
+"""Bad input: each group exits 2 with one accurate line on stderr, is checked before any
+work, writes nothing half-way and never deletes a user's file."""
 
 from __future__ import annotations
 

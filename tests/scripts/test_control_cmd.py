@@ -58,8 +58,8 @@ def test_bad_input_exits_2_and_writes_nothing(tmp_path):
 
 def test_a_search_that_gives_up_before_the_end_exits_1_with_the_reason(tmp_path, monkeypatch):
     """The search may give up (every sample falls within its look-ahead) before the requested
-    time without the body on the floor yet: that is no success (issue 9: "tracked 0.63 s,
-    fell never", exit 0)."""
+    time without the body on the floor yet: that is no success, so it must not
+    report "tracked 0.63 s, fell never" and exit 0."""
     import dataclasses
 
     import avatarsim.sim.control.search as control_search

@@ -1,4 +1,4 @@
-"""Hostile configs (issue 28, "Config values of the wrong type or size" and ``check --config``):
+"""Hostile configs (values of the wrong type or size, and ``check --config``):
 each exits 2 at once through the CLI with one line naming the field, and writes nothing."""
 
 from __future__ import annotations

@@ -43,7 +43,7 @@ def test_noise_free_kinect_reproduces_body17_within_1cm(box_truth, clean_kinect,
     truth = body17_positions(motion_at_rate(box_truth, 30.0))
     err = np.linalg.norm(body17_positions(out) - truth, axis=-1)
     # Measured (box, walk, squat; both sensors): mean 0.01-0.06 cm, max 1.0 cm (Azure squat
-    # heads, whose neck-head bone the sensor turns with the head); the bound is 1 cm.
+    # heads, whose neck-head bone the sensor turns with the head); our bound is 1 cm.
     assert err.mean(axis=0).max() < 1.0
     assert np.percentile(err, 99) < 1.0
 
