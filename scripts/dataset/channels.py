@@ -13,7 +13,8 @@ whose motion and body every channel shares, and a channel seed.
   ``fisheye_conf`` are what a 2D detector reports
   (:class:`render_cams.fisheye.detector.ErrorModelDetector`, its default error model,
   seeded): the exact projections are ``fisheye_uv_projected``.
-- :func:`kinect_channel`: the Kinect skeleton with tracking states.
+- :func:`kinect_channel`: the Kinect skeleton with tracking states (tracked on the rendered
+  depth by default).
 - :func:`fisheye_image_channel` and the Kinect's depth (:func:`kinect_channel`): rendered
   images of every ``image_stride``-th camera frame, one encoded file per camera and frame
   (JPEG or PNG RGB; 16-bit PNG depth in millimetres), as WebDataset stores images; their
@@ -39,6 +40,7 @@ from avatarsim.render_cams.fisheye.keypoints import confidence, project_joints, 
 from avatarsim.render_cams.fisheye.pose2d import controller_views
 from avatarsim.render_cams.fisheye.rig import camera_poses, controller_cameras, inside_body
 from avatarsim.render_cams.kinect import Kinect
+from avatarsim.render_cams.kinect.tracker import SKELETON_SOURCE
 from avatarsim.render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
 from avatarsim.scripts.dataset.config import DeviceSetConfig
 from avatarsim.scripts.stages.devices import REALISTIC_NOISE
@@ -144,14 +146,23 @@ def fisheye_channel(humanoid: Humanoid, seed: int) -> Channel:
     return arrays, meta
 
 
-def kinect_channel(humanoid: Humanoid, sensor: str, seed: int, depth_stride: int = 0) -> Channel:
+def kinect_channel(
+    humanoid: Humanoid,
+    sensor: str,
+    seed: int,
+    depth_stride: int = 0,
+    skeleton: str = SKELETON_SOURCE,
+) -> Channel:
     """``kinect_pos`` (Tk, J, 3) world metres (meaningless where not tracked),
     ``kinect_quat`` (Tk, J, 4) wxyz, ``kinect_state`` (Tk, J) int8 (0 not tracked,
-    1 inferred, 2 tracked); sensor intrinsics and pose in the JSON. With ``depth_stride``,
-    also the depth of every ``depth_stride``-th frame: ``kinect_depth_frames`` (N,) int
-    frame indices into Tk and ``kinect_depth.{n:04d}.png`` (H, W) uint16 millimetres (0: no
-    reading), rendered with the skeleton's seed."""
-    recording = Kinect(sensor).sample(humanoid.motion, seed=seed, body=humanoid.body)
+    1 inferred, 2 tracked) of the ``Kinect`` device's ``skeleton`` (tracked on the rendered
+    depth, or ``"oracle-noise"``: not a sensor, the JSON's ``skeleton_note`` says so); sensor
+    intrinsics and pose in the JSON. With ``depth_stride``, also the depth of every
+    ``depth_stride``-th frame: ``kinect_depth_frames`` (N,) int frame indices into Tk and
+    ``kinect_depth.{n:04d}.png`` (H, W) uint16 millimetres (0: no reading), rendered with the
+    skeleton's seed."""
+    kinect = Kinect(sensor, skeleton=skeleton)
+    recording = kinect.sample(humanoid.motion, seed=seed, body=humanoid.body)
     skeleton = recording.skeleton
     arrays: dict[str, Any] = {
         "kinect_pos": f32(skeleton.positions),

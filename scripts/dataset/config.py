@@ -28,6 +28,7 @@ SPLIT_TOLERANCE = 1e-6
 SourceKind = Literal["builtin", "mocap"]
 VrNoise = Literal["none", "realistic"]
 KinectSensor = Literal["none", "kinect-v2", "azure-kinect"]
+KinectSkeleton = Literal["tracker", "oracle-noise"]
 ImageFormat = Literal["none", "jpeg", "png"]
 MocapSplitBy = Literal["clip", "performer"]
 
@@ -78,6 +79,9 @@ class DeviceSetConfig:
             (needs ``fisheye``).
         kinect: ``"none"``, ``"kinect-v2"`` or ``"azure-kinect"``: the skeleton with
             tracking states.
+        kinect_skeleton: ``"tracker"`` (tracked on the rendered depth, as the SDK does) or
+            ``"oracle-noise"`` (the true joints plus noise: not a sensor, labelled so in
+            every sample's JSON).
         kinect_depth: the Kinect's 16-bit depth images in millimetres, PNG (needs a
             ``kinect``).
         image_stride: images and depth of every ``image_stride``-th camera frame (rendering
@@ -93,6 +97,7 @@ class DeviceSetConfig:
     fisheye: bool = True
     fisheye_images: ImageFormat = "none"
     kinect: KinectSensor = "none"
+    kinect_skeleton: KinectSkeleton = "tracker"
     kinect_depth: bool = False
     image_stride: int = setting(3, ge=1)
     image_scale: float = setting(0.5, ge=SCALE_RANGE[0], le=SCALE_RANGE[1])

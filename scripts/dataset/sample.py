@@ -86,7 +86,7 @@ def make_sample(
     if devices.kinect != "none":
         depth_stride = devices.image_stride if devices.kinect_depth else 0
         arrays_kinect, channels["kinect"] = kinect_channel(
-            humanoid, devices.kinect, seeds["kinect"], depth_stride
+            humanoid, devices.kinect, seeds["kinect"], depth_stride, devices.kinect_skeleton
         )
         arrays |= arrays_kinect
     if devices.physics:
