@@ -212,8 +212,9 @@ def rig_joints_from_body17(b17: np.ndarray, rig: Rig) -> tuple[np.ndarray, np.nd
             a0, a1 = (INDEX[x] for x in _REFERENCE_SEGMENT[b])
             rest_bone = rig_b17[a1] - rig_b17[a0]
             bone = b17[:, a1] - b17[:, a0]
-            with np.errstate(invalid="ignore"):
-                scale = np.nanmedian(np.linalg.norm(bone, axis=-1)) / np.linalg.norm(rest_bone)
+            lengths = np.linalg.norm(bone, axis=-1)
+            lengths = lengths[np.isfinite(lengths)]  # none: the segment was never found
+            scale = (np.median(lengths) if lengths.size else np.nan) / np.linalg.norm(rest_bone)
             rot = torso if b in _TORSO_ANCHORS else _shortest_rotation(rest_bone, bone)
             offset = (rig_rest[j] - rig_b17[INDEX[b]]) * scale
             positions[:, j] = b17[:, INDEX[b]] + rot @ offset
