@@ -26,7 +26,7 @@ from avatarsim.render_cams.kinect.depth import KinectDepthCamera
 from avatarsim.render_cams.kinect.features import DepthFeatures, body_depth
 from avatarsim.render_cams.kinect.forest import from_sklearn
 from avatarsim.render_cams.kinect.parts import N_PARTS
-from avatarsim.render_cams.kinect.placement import default_sensor_pose, performer_target
+from avatarsim.render_cams.kinect.placement import default_sensor_pose, orbit, performer_target
 from avatarsim.render_cams.kinect.sensors import SENSORS, KinectError, get_sensor
 from avatarsim.render_cams.kinect.tracker import BodyPartTracker, load_tracker
 from avatarsim.render_cams.scene import BodyScene
@@ -103,15 +103,6 @@ def check_model_output(path: str | Path) -> None:
             f"{path} exists and is not a model this command wrote; choose another --out or "
             "move it away"
         )
-
-
-def orbit(pose: np.ndarray, centre: np.ndarray, yaw_rad: float) -> np.ndarray:
-    """``pose (4, 4)`` turned by ``yaw_rad`` about the vertical axis through ``centre``."""
-    c, s = np.cos(yaw_rad), np.sin(yaw_rad)
-    turn = np.eye(4)
-    turn[:3, :3] = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
-    turn[:3, 3] = centre - turn[:3, :3] @ centre
-    return turn @ pose
 
 
 def render_views(motion, sensor, poses, rng, noise="default"):

@@ -12,11 +12,11 @@ from avatarsim.avatar_models.rigs import body17_positions, load_rig
 from avatarsim.render_cams.device import motion_at_rate
 from avatarsim.render_cams.kinect.depth import BODY_INDEX_NONE, DepthFrame
 from avatarsim.render_cams.kinect.device import Kinect
-from avatarsim.render_cams.kinect.placement import default_sensor_pose, performer_target
+from avatarsim.render_cams.kinect.placement import default_sensor_pose, orbit, performer_target
 from avatarsim.render_cams.kinect.sensors import get_sensor
 from avatarsim.render_cams.kinect.skeleton import TrackingState
 from avatarsim.render_cams.kinect.tracker import load_tracker, track
-from avatarsim.render_cams.kinect.training import TrackerTrainingConfig, orbit, train_tracker
+from avatarsim.render_cams.kinect.training import TrackerTrainingConfig, train_tracker
 from tests.render_cams.kinect_builders import t_pose
 
 WALK = generate("walk", duration_s=1.0, fps=30.0, seed=100)  # a subject never trained on
