@@ -12,6 +12,7 @@ thresholds) on the same frames. Deterministic for a config and seed.
 from __future__ import annotations
 
 import hashlib
+import warnings
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -221,4 +222,6 @@ def _proposal_statistics(tracker, frames, poses, joints, K) -> tuple[np.ndarray,
         truth_z = ((b17 - pose[:3, 3]) @ pose[:3, :3])[:, 2]
         pushes.append(truth_z - modes[:, 2])
         areas.append(np.where(conf > 0, conf, np.nan))
-    return np.nan_to_num(np.nanmedian(pushes, 0)), np.nan_to_num(np.nanmedian(areas, 0))
+    with warnings.catch_warnings():  # a part never proposed in the set: 0 (no push, area)
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return np.nan_to_num(np.nanmedian(pushes, 0)), np.nan_to_num(np.nanmedian(areas, 0))
