@@ -142,10 +142,14 @@ def config_hash(config: DatasetConfig) -> str:
     """sha256 (hex) of the normalised config, keys sorted, each source's and device set's
     keys at their defaults left out: a key added later whose default keeps the old output
     (a new channel, off unless asked for) leaves the hash, and so resuming and verifying
-    datasets made before it, unchanged."""
+    datasets made before it, unchanged. ``kinect_skeleton`` always counts where there is a
+    Kinect: its default, the tracker, changed what such datasets hold."""
     data = config.as_dict()
     for key, table in (("sources", config.sources), ("devices", config.devices)):
         data[key] = [_without_defaults(t) for t in table]
+    for values, device in zip(data["devices"], config.devices, strict=True):
+        if device.kinect != "none":  # its skeleton was the oracle before the key existed
+            values["kinect_skeleton"] = device.kinect_skeleton
     text = json.dumps(data, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()
 
