@@ -44,6 +44,14 @@ err_console = Console(stderr=True)
 
 JsonOpt = Annotated[Path | None, typer.Option("--json", help="Also write the result as JSON here.")]
 SeedOpt = Annotated[int, typer.Option("--seed", help="Seed for everything stochastic.")]
+KinectSkeletonOpt = Annotated[
+    str,
+    typer.Option(
+        "--kinect-skeleton",
+        help="The Kinect's skeleton: tracker (tracked on the rendered depth, as the SDK does) "
+        "or oracle-noise (the true joints plus noise: not a sensor, faster).",
+    ),
+]
 
 
 def _one_line(text: object) -> str:
@@ -59,6 +67,12 @@ def _check_common(kwargs: dict[str, Any]) -> None:
     motion = kwargs.get("motion", kwargs.get("src"))
     if kwargs.get("unit") is not None and str(motion).startswith(BUILTIN_PREFIX):
         raise AvatarsimError(f"--unit applies to motion files; {motion} is in metres already")
+    skeleton = kwargs.get("kinect_skeleton")
+    if skeleton is not None:
+        from avatarsim.render_cams.kinect.device import SKELETONS
+
+        if skeleton not in SKELETONS:
+            raise AvatarsimError(f"--kinect-skeleton must be one of {SKELETONS}, got {skeleton!r}")
 
 
 def user_errors(fn: Callable[..., Any]) -> Callable[..., Any]:

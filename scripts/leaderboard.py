@@ -6,7 +6,8 @@ training trials (built once, shared by every CoolMoves variant), the distance th
 chosen on the training data (:mod:`synthesis.evaluate.validation`), and per test trial one
 VR stream that every method (:data:`synthesis.methods.METHODS`) runs on, plus one recording
 of each further sensor a selected method declares (``Method.sensors``, recorded by
-:data:`RECORDERS`: MoveBox's Kinect V2 skeleton stream, ControllerPose's controller-camera
+:data:`RECORDERS`: MoveBox's Kinect V2 skeleton stream, tracked on the rendered depth by the
+``Kinect`` device, ControllerPose's controller-camera
 keypoints), and AvatarGo's walk-in T-pose sample of the six VR devices, through
 :func:`scripts.method_score.score_method` (timed ``step`` calls included). A method's numbers
 are means over the trials of a class, then over classes (each class counts once, as the
@@ -199,9 +200,10 @@ def tracked_notes(board: dict) -> list[str]:
     ]
 
 
-FOLD_FORMAT = 2
-"""The saved fold's layout; 2: with the sensors' tracked shares. A fold saved in another
-layout is recomputed."""
+FOLD_FORMAT = 3
+"""The saved fold's layout and inputs; 2: with the sensors' tracked shares; 3: the Kinect's
+skeleton tracked on its depth (before: the truth plus noise). A fold saved under another
+format is recomputed."""
 
 
 def fold_key(fold, methods: Sequence[str], tune: bool) -> dict:

@@ -6,12 +6,13 @@ Azure Kinect):
 
 - ``retarget_err_cm``: mean body17 error of the retargeting stage alone, at the sensor's
   30 Hz, over frames whose body17-driving joints are all Tracked; ``noise_free`` (exact
-  joints) and ``noisy`` (the sensor's skeleton noise) beside ``kinect_err_cm``, the error
-  of the noisy Kinect joints themselves (the sensor noise the retargeting error is judged against).
+  joints) and ``sensed`` (the ``Kinect`` device's skeleton: tracked on the rendered depth,
+  or with ``skeleton="oracle-noise"`` the truth plus noise, not a sensor) beside
+  ``kinect_err_cm``, the error of the sensed Kinect joints themselves.
 - ``roll_err_deg``: mean absolute twist of the limb bones (upper arms, forearms, thighs,
   calves) between truth and retargeting, noise-free, with roll recovery (``rest``) and with
   the sensor's roll (``sensor``); built-in takes only (the truth must be on the avatar rig).
-- ``jitter_m_s3``: RMS jerk of the body17 joints of the 90 Hz output, noisy input, without
+- ``jitter_m_s3``: RMS jerk of the body17 joints of the 90 Hz output, sensed input, without
   smoothing (sample-and-hold) and with it; ``truth`` for reference.
 - ``method``: the whole method (streaming clock, tracking-state rules, smoothing) scored on
   the 90 Hz clock (:func:`scripts.method_score.score_method`), with every physics check;
@@ -48,12 +49,15 @@ from avatarsim.avatar_models.measure import standing_height
 from avatarsim.avatar_models.rigs import body17_positions, load_rig
 from avatarsim.render_cams.device import motion_at_rate
 from avatarsim.render_cams.kinect import (
+    Kinect,
     KinectSkeletonStream,
     TrackingState,
     kinect_skeleton,
     read_kinect_skeleton,
 )
 from avatarsim.render_cams.kinect.sensors import KINECT_RATE_HZ
+from avatarsim.render_cams.kinect.skeleton import ORACLE_NOTE
+from avatarsim.render_cams.kinect.tracker import SKELETON_SOURCE
 from avatarsim.render_cams.vr import VRSetup
 from avatarsim.scripts.method_score import score_method
 from avatarsim.sim.humanoid import Humanoid, humanoid_for
@@ -112,14 +116,18 @@ def real_takes(folder: Path, per_source: int, duration_s: float) -> list[Take]:
     return takes
 
 
-def filmed(motion: Motion, sensor: str = "kinect-v2", seed: int = 0) -> KinectSkeletonStream:
-    """The Kinect stream of ``motion``: filmed on its own body, or, for a rig whose rest pose
-    does not stand (Bandai's), on its humanoid (the motion retargeted onto the avatar body)."""
+def filmed(
+    motion: Motion, sensor: str = "kinect-v2", seed: int = 0, skeleton: str = SKELETON_SOURCE
+) -> KinectSkeletonStream:
+    """The ``Kinect`` device's ``skeleton`` stream of ``motion`` (tracked on the rendered
+    depth by default): filmed on its own body, or, for a rig whose rest pose does not stand
+    (Bandai's), on its humanoid (the motion retargeted onto the avatar body)."""
+    kinect = Kinect(sensor, skeleton=skeleton)
     try:
-        return kinect_skeleton(motion, sensor, seed=seed)
+        return kinect.sample(motion, seed).skeleton
     except RestPoseNotUprightError:
         humanoid = humanoid_for(motion)
-        return kinect_skeleton(humanoid.motion, sensor, seed=seed, body=humanoid.body)
+        return kinect.sample(humanoid.motion, seed, humanoid.body).skeleton
 
 
 def body17_tracked(kinect: KinectSkeletonStream) -> np.ndarray:
@@ -197,18 +205,24 @@ def resized_avatar(kinect: KinectSkeletonStream):
 
 
 def evaluate_sensor(
-    take: Take, humanoid: Humanoid, sensor: str, seed: int, checks: CheckConfig
+    take: Take,
+    humanoid: Humanoid,
+    sensor: str,
+    seed: int,
+    checks: CheckConfig,
+    skeleton: str = SKELETON_SOURCE,
 ) -> dict:
     """Every number of the module docstring for one take and sensor. The Kinect films the
     take on its ``humanoid`` (a real clip's rig retargeted onto the avatar body, whose rest
-    pose stands); errors are against the take itself, NaN over tracked frames when there
-    are none (the share says so)."""
+    pose stands) with its ``skeleton`` (:data:`~render_cams.kinect.SKELETONS`); errors are
+    against the take itself, NaN over tracked frames when there are none (the share says
+    so)."""
     truth = take.truth
-    on_body = (humanoid.motion, sensor)
-    clean = kinect_skeleton(*on_body, seed=seed, noise=None, body=humanoid.body)
-    noisy = kinect_skeleton(*on_body, seed=seed, body=humanoid.body)
+    clean = kinect_skeleton(humanoid.motion, sensor, seed=seed, noise=None, body=humanoid.body)
+    kinect = Kinect(sensor, skeleton=skeleton)
+    sensed = kinect.sample(humanoid.motion, seed, humanoid.body).skeleton
     truth30 = motion_at_rate(truth, clean.meta["rate_hz"])
-    tracked = body17_tracked(noisy)
+    tracked = body17_tracked(sensed)
     target = avatar_for(humanoid.body.skeleton, standing_height(humanoid.motion))
     try:
         uniform = resized_avatar(clean)
@@ -218,8 +232,8 @@ def evaluate_sensor(
         "tracked_frames_frac": float(tracked.mean()),
         "retarget_err_cm": {
             "noise_free": body17_err_cm(retargeted(clean, target, "hinge"), truth30, tracked),
-            "noisy": body17_err_cm(retargeted(noisy, target, "hinge"), truth30, tracked),
-            "kinect_err_cm": kinect_err_cm(noisy, truth30, tracked),
+            "sensed": body17_err_cm(retargeted(sensed, target, "hinge"), truth30, tracked),
+            "kinect_err_cm": kinect_err_cm(sensed, truth30, tracked),
             "resized_avatar": float("nan")
             if uniform is None
             else body17_err_cm(retargeted(clean, uniform, "hinge"), truth30, tracked),
@@ -230,8 +244,8 @@ def evaluate_sensor(
             roll: roll_err_deg(retargeted(clean, target, roll), truth30, tracked) for roll in ROLLS
         }
     stream = VRSetup().sample(truth, seed=seed)
-    raw = MoveBox(noisy, target, tau_s=0.0).run(stream)
-    result = score_method(MoveBox(noisy, target), truth, stream, checks)
+    raw = MoveBox(sensed, target, tau_s=0.0).run(stream)
+    result = score_method(MoveBox(sensed, target), truth, stream, checks)
     smoothed = result.score.output
     row["jitter_m_s3"] = {
         "unsmoothed": rms_jerk(raw),
@@ -241,7 +255,7 @@ def evaluate_sensor(
     ticks = on_clock(stream).timestamps
     row["method"] = {
         "err_cm": result.score.err_cm,
-        "err_cm_tracked": body17_errors_cm(smoothed, truth, frames=shown_tracked(noisy, ticks)),
+        "err_cm_tracked": body17_errors_cm(smoothed, truth, frames=shown_tracked(sensed, ticks)),
         "physics": result.physics,
     }
     search = int(LOOP_SEARCH_S * smoothed.fps)
@@ -279,16 +293,21 @@ def run_movebox_eval(
     seed: int = 0,
     audio: list[Path] = (),
     progress=None,
+    skeleton: str = SKELETON_SOURCE,
 ) -> dict:
-    """``{"takes": {label: {sensor: row}}, "summary": {sensor: means}, "lip_sync": ...}``."""
+    """``{"takes": {label: {sensor: row}}, "summary": {sensor: means}, "lip_sync": ...,
+    "skeleton": ...}``, on the Kinect's ``skeleton`` (:data:`~render_cams.kinect.SKELETONS`)."""
     checks = CheckConfig()
     rows: dict[str, dict] = {}
     for i, take in enumerate(takes):
         humanoid = humanoid_for(take.truth)
-        rows[take.label] = {s: evaluate_sensor(take, humanoid, s, seed, checks) for s in sensors}
+        rows[take.label] = {
+            s: evaluate_sensor(take, humanoid, s, seed, checks, skeleton) for s in sensors
+        }
         if progress is not None:
             progress(i + 1, len(takes), take.label)
     out = {"takes": rows, "summary": summarise(rows, sensors), "seed": seed}
+    out["skeleton"] = skeleton if skeleton == SKELETON_SOURCE else f"{skeleton} ({ORACLE_NOTE})"
     if audio:
         out["lip_sync"] = lip_sync_scores(list(audio))
     return out

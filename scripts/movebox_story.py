@@ -17,7 +17,7 @@ from avatarsim.avatar_models import Motion
 from avatarsim.avatar_models.fileio import write_atomic
 from avatarsim.avatar_models.generator import Subject, generate
 from avatarsim.avatar_models.rigs import load_rig
-from avatarsim.render_cams.kinect import kinect_skeleton
+from avatarsim.render_cams.kinect import Kinect
 from avatarsim.synthesis.movebox import MoveBox
 from avatarsim.synthesis.movebox.face import lip_sync, read_wav
 from avatarsim.synthesis.movebox.recording import playback
@@ -44,9 +44,10 @@ KEY_FPS = 10.0
 
 def record_take(activity: str, height_m: float, seconds: float, seed: int) -> Motion:
     """One actor alone in front of a Kinect V2, recorded by MoveBox on an avatar of the
-    performer's own size (30 Hz: the takes are played back at the sensor's rate)."""
+    performer's own size (30 Hz: the takes are played back at the sensor's rate), from the
+    skeleton the Kinect tracks on its depth."""
     performer = generate(activity, Subject(height_m=height_m), seconds, 90.0, seed)
-    kinect = kinect_skeleton(performer, "kinect-v2", seed=seed)
+    kinect = Kinect("kinect-v2").sample(performer, seed).skeleton
     avatar = resized(load_rig("avatar").skeleton, height_m)
     return MoveBox(kinect, avatar).record(30.0)
 

@@ -95,11 +95,15 @@ class DevicesSpec:
     (Lighthouse-grade jitter, latency, slow drift). For sweeps, ``latency_s``, ``jitter_m``
     (position, per axis) and ``dropouts_per_s`` (0.5 s bursts of tracking loss) add one
     more model each, after the preset. ``kinect`` (``"kinect-v2"`` or ``"azure-kinect"``)
-    also records the Kinect skeleton stream (30 Hz) that MoveBox runs on. ``fisheye`` records
+    also records the Kinect skeleton stream (30 Hz) that MoveBox runs on: ``kinect_skeleton``
+    ``"tracker"`` (default) tracks it on the rendered depth as the SDK does, ``"oracle-noise"``
+    takes the true joints plus noise (not a sensor: it never loses or swaps a joint; labelled
+    so in the results). ``fisheye`` records
     the controller cameras' 2D keypoints too (ControllerPose's input)."""
 
     vr: bool = True
     kinect: str | None = None
+    kinect_skeleton: Literal["tracker", "oracle-noise"] = "tracker"
     fisheye: bool = False
     trackers: bool = False
     noise: Literal["none", "realistic"] = "realistic"

@@ -21,11 +21,14 @@ JUDGING_ONLY = ("name", "seed", "path", "thresholds", "expect_fail", "regression
 
 def normalised(scenario: Scenario) -> dict:
     """The scenario as plain data without :data:`JUDGING_ONLY`; a motion file's path is made
-    relative to the scenario file, so the hash holds across checkouts."""
+    relative to the scenario file, so the hash holds across checkouts; the Kinect's skeleton
+    source only where there is a Kinect."""
     data = dataclasses.asdict(scenario)
     source = scenario.motion.source
     if source != "builtin" and scenario.path is not None:
         data["motion"]["source"] = os.path.relpath(source, Path(scenario.path).parent)
+    if data.get("devices") is not None and not data["devices"]["kinect"]:
+        del data["devices"]["kinect_skeleton"]  # no Kinect: it decides nothing
     return {k: v for k, v in data.items() if k not in JUDGING_ONLY}
 
 

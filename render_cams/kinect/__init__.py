@@ -5,12 +5,13 @@ and 30 Hz skeleton streams.
 - :mod:`.noise`: axial/lateral depth noise, flying pixels, invalid pixels.
 - :mod:`.depth`: depth frames and body-index maps rendered from a ``BodyScene``; PNG writers.
 - :mod:`.rig_joints`: joints and orientations of the kinect_v2 / azure_kinect rigs on a motion.
-- :mod:`.skeleton`: the skeleton stream: tracking state, noise.
+- :mod:`.tracker`: the body-part tracker on the depth (the ``Kinect``'s skeleton).
+- :mod:`.skeleton`: the skeleton stream; the truth-plus-noise oracle (not a sensor).
 - :mod:`.device`: the ``Kinect`` device and its in-memory ``KinectRecording``.
 - :mod:`.sequence`: a recording on disk (depth, body index, skeleton JSON, preview).
 """
 
-from avatarsim.render_cams.kinect.device import Kinect, KinectRecording
+from avatarsim.render_cams.kinect.device import SKELETONS, Kinect, KinectRecording
 from avatarsim.render_cams.kinect.noise import DepthNoiseModel
 from avatarsim.render_cams.kinect.placement import (
     KinectPlacementError,
@@ -29,6 +30,7 @@ from avatarsim.render_cams.kinect.skeleton import (
 
 __all__ = [
     "SENSORS",
+    "SKELETONS",
     "DepthNoiseModel",
     "DepthSensor",
     "Kinect",

@@ -8,10 +8,12 @@ that a long take streams to disk in constant memory (a 600 s Azure Kinect take w
 20 GB). :func:`render_cams.kinect.sequence.write_kinect_recording` writes a recording to a
 folder.
 
-The skeleton (``skeleton=``): ``"tracker"`` runs the body-part tracker of
+The skeleton (``skeleton=``): ``"tracker"`` (the default) runs the body-part tracker of
 :mod:`.tracker` on the rendered depth frames, as the SDKs do; ``"oracle-noise"`` is the
-truth-plus-noise approximation of :func:`~render_cams.kinect.skeleton.kinect_skeleton`,
-labelled as not a sensor in the stream's meta, the record and every skeleton frame.
+truth-plus-noise approximation of :func:`~render_cams.kinect.skeleton.kinect_skeleton`, not a
+sensor (it never looks at the depth, so it never loses or swaps a joint the way a Kinect
+does), labelled so in the stream's meta, the record and every skeleton frame: a fast
+stand-in where only its speed matters.
 
 One seed drives both noises: the skeleton noise uses it as it is, the depth noise the stream
 ``[seed, 1]``.
@@ -124,7 +126,8 @@ class Kinect:
         max_frames: record at most this many frames (from the start).
         depth_noise, skeleton_noise: ``"default"``, a model, or ``None`` for clean output
             (``skeleton_noise`` is the oracle's).
-        skeleton: :data:`SKELETONS`: ``"tracker"`` (from the depth) or ``"oracle-noise"``.
+        skeleton: :data:`SKELETONS`: ``"tracker"`` (from the depth, the default) or
+            ``"oracle-noise"`` (the truth plus noise, not a sensor).
         tracker_model: the tracker's ``.npz`` model; None: the shipped one.
     """
 
@@ -134,7 +137,7 @@ class Kinect:
     max_frames: int | None = None
     depth_noise: Any = "default"
     skeleton_noise: Any = "default"
-    skeleton: str = ORACLE_SKELETON
+    skeleton: str = SKELETON_SOURCE
     tracker_model: str | Path | None = None
 
     def __post_init__(self) -> None:

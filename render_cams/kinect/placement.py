@@ -197,3 +197,12 @@ def check_sensor_pose(camera_to_world: np.ndarray, body: BodyDescription, motion
             f"frame (segment {body.segments[seg].name!r}); place it in front of the user, "
             "or leave the pose to the automatic set-up"
         )
+
+
+def orbit(pose: np.ndarray, centre: np.ndarray, yaw_rad: float) -> np.ndarray:
+    """``pose (4, 4)`` turned by ``yaw_rad`` about the vertical axis through ``centre``."""
+    c, s = np.cos(yaw_rad), np.sin(yaw_rad)
+    turn = np.eye(4)
+    turn[:3, :3] = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
+    turn[:3, 3] = centre - turn[:3, :3] @ centre
+    return turn @ pose

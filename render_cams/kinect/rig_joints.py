@@ -1,4 +1,5 @@
-"""Kinect rig joints placed on any :class:`~avatar_models.Motion` (no noise, no tracking).
+"""Kinect rig joints placed on any :class:`~avatar_models.Motion` (no noise, no tracking; the
+oracle skeleton's), or on a tracker's body17 joints (:func:`rig_joints_from_body17`).
 
 Joints on a Kinect rig (``kinect_v2``: 25, ``azure_kinect``: 32) come from the motion's body17
 joints: mapped joints are the body17 positions themselves; spine levels lie on the pelvis-neck
@@ -6,7 +7,8 @@ line at the rig's rest fractions; other joints (hands, hand tips, thumbs, clavic
 ears) keep their rest offset from an anchor joint, scaled by the subject's segment length and
 turned with the anchor (the motion's own wrist/head rotation, or the torso frame of body17).
 
-Orientations (world, wxyz, relative to the rig's T-pose): Kinect V2 has no bone roll, so each
+Orientations of the oracle (world, wxyz, relative to the rig's T-pose; a tracker's come
+from :mod:`.orientations`): Kinect V2 has no bone roll, so each
 joint's orientation is the shortest rotation taking its rest bone (parent -> joint) to the
 current one (MoveBox paper, section IV-A1). Azure Kinect reports full orientations: the
 anchor's rotation (the motion's joint rotation aligned to the rig's rest bone, or the torso
@@ -183,16 +185,15 @@ def _swing_orientations(positions: np.ndarray, rest: np.ndarray, parents) -> np.
     return np.where(lost[..., None], np.nan, quat.from_matrix(swing))
 
 
-def rig_joints_from_body17(b17: np.ndarray, rig: Rig) -> tuple[np.ndarray, np.ndarray]:
-    """``(T, J, 3)`` positions and ``(T, J, 4)`` roll-free orientations of ``rig``'s joints
-    from measured body17 positions ``(T, 17, 3)`` alone (a tracker's output; NaN where a
-    joint was not found, and NaN in every joint built from it).
+def rig_joints_from_body17(b17: np.ndarray, rig: Rig) -> np.ndarray:
+    """``(T, J, 3)`` positions of ``rig``'s joints from measured body17 positions
+    ``(T, 17, 3)`` alone (a tracker's output; NaN where a joint was not found, and NaN in
+    every joint built from it); their orientations are :mod:`.orientations`'.
 
     Mapped joints are the body17 points, spine levels lie on the pelvis-neck line, and every
     other joint keeps its rest offset from its anchor, scaled by the take's median length of
     the anchor's reference segment and swung with that segment (torso frame for torso
-    anchors): positions carry no roll, so neither do orientations, which are
-    the swing of each rest bone onto the measured bone for both rigs."""
+    anchors)."""
     rig_rest = _rest_positions(rig.skeleton)
     rig_b17 = rig_rest[rig.body17_indices()]
     names = rig.skeleton.names
@@ -212,12 +213,13 @@ def rig_joints_from_body17(b17: np.ndarray, rig: Rig) -> tuple[np.ndarray, np.nd
             a0, a1 = (INDEX[x] for x in _REFERENCE_SEGMENT[b])
             rest_bone = rig_b17[a1] - rig_b17[a0]
             bone = b17[:, a1] - b17[:, a0]
-            with np.errstate(invalid="ignore"):
-                scale = np.nanmedian(np.linalg.norm(bone, axis=-1)) / np.linalg.norm(rest_bone)
+            lengths = np.linalg.norm(bone, axis=-1)
+            lengths = lengths[np.isfinite(lengths)]  # none: the segment was never found
+            scale = (np.median(lengths) if lengths.size else np.nan) / np.linalg.norm(rest_bone)
             rot = torso if b in _TORSO_ANCHORS else _shortest_rotation(rest_bone, bone)
             offset = (rig_rest[j] - rig_b17[INDEX[b]]) * scale
             positions[:, j] = b17[:, INDEX[b]] + rot @ offset
-    return positions, _swing_orientations(positions, rig_rest, rig.skeleton.parents)
+    return positions
 
 
 def body17_dependencies(rig: Rig) -> list[np.ndarray]:

@@ -128,6 +128,7 @@ class KinectSkeletonStream:
             "timestamp_s": float(self.timestamps[t]),
             "rig": self.rig,
             "skeleton": self.meta.get("skeleton"),
+            **{k: self.meta[k] for k in ("skeleton_note",) if k in self.meta},
             "body_tracked": bool(np.any(states != TrackingState.NOT_TRACKED)),
             "joints": [
                 {

@@ -9,7 +9,8 @@ is pushed from the surface along the viewing ray by the part's learned depth off
 (Shotton section 4, ``zeta_c``). Its confidence is the surface area (m^2) within one bandwidth
 of the mode; a joint is Tracked above ``tracked_area_m2``, Inferred above
 ``inferred_area_m2``, NotTracked below (no proposal). Over a take, the joints go through the
-SDK's smoothing (:mod:`.smoothing`) and onto the sensor's rig (:mod:`.rig_joints`).
+SDK's smoothing (:mod:`.smoothing`) and onto the sensor's rig (:mod:`.rig_joints`), whose
+orientations the sensor derives from those positions (:mod:`.orientations`).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from avatarsim.avatar_models.rigs import load_rig
 from avatarsim.render_cams.kinect.features import BACKGROUND_M, body_depth
 from avatarsim.render_cams.kinect.forest import Forest, load_forest
 from avatarsim.render_cams.kinect.meanshift import densest_mode
+from avatarsim.render_cams.kinect.orientations import tracked_orientations
 from avatarsim.render_cams.kinect.parts import N_PARTS
 from avatarsim.render_cams.kinect.rig_joints import body17_dependencies, rig_joints_from_body17
 from avatarsim.render_cams.kinect.sensors import DepthSensor, KinectError
@@ -171,7 +173,8 @@ def track(
         world = smooth_joints(world, live, b17_states == TrackingState.INFERRED, smoothing)
     world = np.where(live[..., None], world, np.nan)
     rig = load_rig(sensor.rig)
-    positions, orientations = rig_joints_from_body17(world, rig)
+    positions = rig_joints_from_body17(world, rig)
+    orientations = tracked_orientations(positions, rig)
     states = np.stack([b17_states[:, deps].min(axis=1) for deps in body17_dependencies(rig)], 1)
     missing = ~np.all(np.isfinite(positions), axis=-1)
     states = np.where(missing, TrackingState.NOT_TRACKED, states).astype(np.int8)

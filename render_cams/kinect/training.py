@@ -12,6 +12,7 @@ thresholds) on the same frames. Deterministic for a config and seed.
 from __future__ import annotations
 
 import hashlib
+import warnings
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -26,7 +27,7 @@ from avatarsim.render_cams.kinect.depth import KinectDepthCamera
 from avatarsim.render_cams.kinect.features import DepthFeatures, body_depth
 from avatarsim.render_cams.kinect.forest import from_sklearn
 from avatarsim.render_cams.kinect.parts import N_PARTS
-from avatarsim.render_cams.kinect.placement import default_sensor_pose, performer_target
+from avatarsim.render_cams.kinect.placement import default_sensor_pose, orbit, performer_target
 from avatarsim.render_cams.kinect.sensors import SENSORS, KinectError, get_sensor
 from avatarsim.render_cams.kinect.tracker import BodyPartTracker, load_tracker
 from avatarsim.render_cams.scene import BodyScene
@@ -103,15 +104,6 @@ def check_model_output(path: str | Path) -> None:
             f"{path} exists and is not a model this command wrote; choose another --out or "
             "move it away"
         )
-
-
-def orbit(pose: np.ndarray, centre: np.ndarray, yaw_rad: float) -> np.ndarray:
-    """``pose (4, 4)`` turned by ``yaw_rad`` about the vertical axis through ``centre``."""
-    c, s = np.cos(yaw_rad), np.sin(yaw_rad)
-    turn = np.eye(4)
-    turn[:3, :3] = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]
-    turn[:3, 3] = centre - turn[:3, :3] @ centre
-    return turn @ pose
 
 
 def render_views(motion, sensor, poses, rng, noise="default"):
@@ -230,4 +222,6 @@ def _proposal_statistics(tracker, frames, poses, joints, K) -> tuple[np.ndarray,
         truth_z = ((b17 - pose[:3, 3]) @ pose[:3, :3])[:, 2]
         pushes.append(truth_z - modes[:, 2])
         areas.append(np.where(conf > 0, conf, np.nan))
-    return np.nan_to_num(np.nanmedian(pushes, 0)), np.nan_to_num(np.nanmedian(areas, 0))
+    with warnings.catch_warnings():  # a part never proposed in the set: 0 (no push, area)
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return np.nan_to_num(np.nanmedian(pushes, 0)), np.nan_to_num(np.nanmedian(areas, 0))

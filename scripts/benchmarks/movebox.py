@@ -32,6 +32,8 @@ def run(quick: bool = False, mocap: Path | None = None) -> list[BenchRow]:
     )
     rows = []
     for sensor in SENSORS:
+        # The oracle skeleton (not a sensor): a step's cost does not depend on where the
+        # joints came from, and tracking the depth would put rendering into a step bench.
         kinect = kinect_skeleton(truth, sensor, seed=0)
         latencies = step_latencies_ms(MoveBox(kinect, truth.skeleton), stream)
         consumed = np.searchsorted(kinect.timestamps, stream.timestamps, side="right")

@@ -28,6 +28,7 @@ from rich.table import Table
 from avatarsim.avatar_models.fileio import write_json
 from avatarsim.scripts.cli_common import (
     JsonOpt,
+    KinectSkeletonOpt,
     SeedOpt,
     check_outputs,
     console,
@@ -171,10 +172,10 @@ def write_avatargo(results: dict, out: Path, json_out: Path | None) -> None:
 def _movebox_tables(results: dict) -> list[Table]:
     """Means per source and sensor, as two narrow tables (names stay whole at 80 columns).
     Retargeting: share of Kinect frames tracking every body17 joint, Kinect joint error,
-    retargeting (noise-free, noisy; cm), roll (hinge/rest/sensor; deg). Method: jerk
+    retargeting (noise-free, sensed; cm), roll (hinge/rest/sensor; deg). Method: jerk
     (raw/smoothed; m/s^3), error over every tick and over tracked ticks (cm), loop seam."""
     columns = {
-        "retargeting": ("tracked", "kinect cm", "clean", "noisy", "roll h/r/s"),
+        "retargeting": ("tracked", "kinect cm", "clean", "sensed", "roll h/r/s"),
         "method": ("jerk", "full cm", "tracked cm", "seam"),
     }
     tables = {}
@@ -196,7 +197,7 @@ def _movebox_tables(results: dict) -> list[Table]:
                 f"{s['tracked_frames_frac']:.0%}",
                 f"{r['kinect_err_cm']:.1f}",
                 f"{r['noise_free']:.2f}",
-                f"{r['noisy']:.1f}",
+                f"{r['sensed']:.1f}",
                 rolls,
             )
             tables["method"].add_row(
@@ -210,7 +211,10 @@ def _movebox_tables(results: dict) -> list[Table]:
     return list(tables.values())
 
 
-def run_movebox(library, out, wanted, per_source, duration, quick, audio, kinect, seed, json_out):
+def run_movebox(
+    library, out, wanted, per_source, duration, quick, audio, kinect, seed, json_out,
+    skeleton="tracker",
+):  # fmt: skip
     """``eval movebox``: inputs checked first (audio, recorded take), then the evaluation
     (:mod:`scripts.movebox_eval`), the story (:mod:`scripts.movebox_story`) and, with
     ``--kinect``, the recorded take retargeted and saved."""
@@ -246,6 +250,7 @@ def run_movebox(library, out, wanted, per_source, duration, quick, audio, kinect
             takes,
             seed=seed,
             audio=files,
+            skeleton=skeleton,
             progress=lambda done, total, label: bar.update(
                 task, completed=done, description=escape(label)
             ),
@@ -636,6 +641,7 @@ def register(app: typer.Typer) -> None:
             Path | None,
             typer.Option(help="A recorded Kinect take folder to retarget and save."),
         ] = None,
+        kinect_skeleton: KinectSkeletonOpt = "tracker",
         quick: QuickOpt = False,
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
@@ -647,7 +653,7 @@ def register(app: typer.Typer) -> None:
         check_outputs(json_out=json_out, out=out)
         run_movebox(
             library, out, _class_list(classes), max_per_class, duration, quick, audio, kinect,
-            seed, json_out,
+            seed, json_out, kinect_skeleton,
         )  # fmt: skip
 
     @group.command()

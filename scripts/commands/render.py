@@ -23,6 +23,7 @@ from rich.markup import escape
 
 from avatarsim.scripts.cli_common import (
     JsonOpt,
+    KinectSkeletonOpt,
     SeedOpt,
     check_outputs,
     console,
@@ -302,6 +303,7 @@ def _kinect_command(device: str) -> Callable[..., None]:
         sensor_height: Annotated[
             float | None, typer.Option(help="Height in metres of the automatic set-up (0.9).")
         ] = None,
+        kinect_skeleton: KinectSkeletonOpt = "tracker",
         unit: UnitOpt = None,
         seed: SeedOpt = 0,
         json_out: JsonOpt = None,
@@ -318,7 +320,9 @@ def _kinect_command(device: str) -> Callable[..., None]:
             aim = pose
             if pos_xyz is not None and aim is None:  # aimed at the performer
                 aim = look_at(pos_xyz, performer_target(humanoid.motion))
-            kinect = Kinect(device, sensor_pose=aim, sensor_height_m=height)
+            kinect = Kinect(
+                device, sensor_pose=aim, sensor_height_m=height, skeleton=kinect_skeleton
+            )
             return write_kinect_recording(
                 kinect.sample(humanoid.motion, seed, humanoid.body), folder
             )
@@ -327,7 +331,9 @@ def _kinect_command(device: str) -> Callable[..., None]:
 
     kinect.__doc__ = (
         f"What the {device} sensor records of MOTION.\n\n16-bit depth PNG in mm, body-index "
-        "PNG, skeleton JSON per frame and a preview video."
+        "PNG, body-part label PNG, skeleton JSON per frame (tracked on the depth; "
+        "--kinect-skeleton oracle-noise: the true joints plus noise, not a sensor) and a "
+        "preview video."
     )
     return kinect
 

@@ -13,10 +13,12 @@ whose motion and body every channel shares, and a channel seed.
   ``fisheye_conf`` are what a 2D detector reports
   (:class:`render_cams.fisheye.detector.ErrorModelDetector`, its default error model,
   seeded): the exact projections are ``fisheye_uv_projected``.
-- :func:`kinect_channel`: the Kinect skeleton with tracking states.
-- :func:`fisheye_image_channel` and the Kinect's depth (:func:`kinect_channel`): rendered
-  images of every ``image_stride``-th camera frame, one encoded file per camera and frame
-  (JPEG or PNG RGB; 16-bit PNG depth in millimetres), as WebDataset stores images; their
+- :func:`kinect_channel`: the Kinect skeleton with tracking states (tracked on the rendered
+  depth by default).
+- :func:`fisheye_image_channel` and the Kinect's depth and body-part labels
+  (:func:`kinect_channel`): rendered images of every ``image_stride``-th camera frame, one
+  encoded file per camera and frame (JPEG or PNG RGB; 16-bit PNG depth in millimetres, 8-bit
+  PNG part labels), as WebDataset stores images; their
   frame indices and the cameras' intrinsics and extrinsics are in arrays and JSON beside
   them.
 - :func:`physics_channel`: per-frame foot contact, floor penetration and foot skate from
@@ -38,7 +40,9 @@ from avatarsim.render_cams.fisheye.device import CAMERA_RATE_HZ, FisheyeRig
 from avatarsim.render_cams.fisheye.keypoints import confidence, project_joints, world_to_camera
 from avatarsim.render_cams.fisheye.pose2d import controller_views
 from avatarsim.render_cams.fisheye.rig import camera_poses, controller_cameras, inside_body
-from avatarsim.render_cams.kinect import Kinect
+from avatarsim.render_cams.kinect import Kinect, default_sensor_pose, get_sensor
+from avatarsim.render_cams.kinect.parts import PART_NAMES
+from avatarsim.render_cams.kinect.placement import orbit, performer_target
 from avatarsim.render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, VRSetup
 from avatarsim.render_cams.vr.noise import REALISTIC_NOISE
 from avatarsim.scripts.dataset.config import DeviceSetConfig
@@ -144,14 +148,26 @@ def fisheye_channel(humanoid: Humanoid, seed: int) -> Channel:
     return arrays, meta
 
 
-def kinect_channel(humanoid: Humanoid, sensor: str, seed: int, depth_stride: int = 0) -> Channel:
+def kinect_channel(humanoid: Humanoid, devices: DeviceSetConfig, seed: int) -> Channel:
     """``kinect_pos`` (Tk, J, 3) world metres (meaningless where not tracked),
     ``kinect_quat`` (Tk, J, 4) wxyz, ``kinect_state`` (Tk, J) int8 (0 not tracked,
-    1 inferred, 2 tracked); sensor intrinsics and pose in the JSON. With ``depth_stride``,
-    also the depth of every ``depth_stride``-th frame: ``kinect_depth_frames`` (N,) int
-    frame indices into Tk and ``kinect_depth.{n:04d}.png`` (H, W) uint16 millimetres (0: no
-    reading), rendered with the skeleton's seed."""
-    recording = Kinect(sensor).sample(humanoid.motion, seed=seed, body=humanoid.body)
+    1 inferred, 2 tracked) of the ``devices.kinect`` sensor's ``kinect_skeleton`` (tracked on
+    the rendered depth, or ``"oracle-noise"``: not a sensor, the JSON's ``skeleton_note``
+    says so), the sensor set up in front of the performer at ``kinect_height_m`` and turned
+    ``kinect_yaw_deg`` about them; sensor intrinsics and pose in the JSON. With
+    ``kinect_depth``, also the depth of every ``image_stride``-th frame, with the sensor's
+    depth noise: ``kinect_depth_frames`` (N,) int frame indices into Tk and
+    ``kinect_depth.{n:04d}.png`` (H, W) uint16 millimetres (0: no reading), rendered with the
+    skeleton's seed; with ``kinect_parts``, ``kinect_parts.{n:04d}.png`` (H, W) uint8, the
+    body-part label of each depth pixel (:mod:`render_cams.kinect.parts`: part ``k + 1`` is
+    body17 joint ``k``, 0 no body), aligned with that depth image."""
+    motion = humanoid.motion
+    sensor = get_sensor(devices.kinect)
+    at_rate = motion_at_rate(motion, sensor.rate_hz)
+    front = default_sensor_pose(at_rate, sensor, devices.kinect_height_m)
+    pose = orbit(front, performer_target(motion), np.radians(devices.kinect_yaw_deg))
+    kinect = Kinect(sensor, sensor_pose=pose, skeleton=devices.kinect_skeleton)
+    recording = kinect.sample(motion, seed=seed, body=humanoid.body)
     skeleton = recording.skeleton
     arrays: dict[str, Any] = {
         "kinect_pos": f32(skeleton.positions),
@@ -159,13 +175,19 @@ def kinect_channel(humanoid: Humanoid, sensor: str, seed: int, depth_stride: int
         "kinect_state": np.ascontiguousarray(skeleton.states, dtype=np.int8),
     }
     meta = dict(recording.record)
-    if depth_stride:
+    meta["yaw_deg"] = devices.kinect_yaw_deg
+    if devices.kinect_depth:
+        stride = devices.image_stride
         frames = recording.frames
-        strided = replace(frames, motion=frames.motion[::depth_stride])
-        arrays["kinect_depth_frames"] = np.arange(len(strided), dtype=np.int32) * depth_stride
+        strided = replace(frames, motion=frames.motion[::stride])
+        arrays["kinect_depth_frames"] = np.arange(len(strided), dtype=np.int32) * stride
         for n, frame in enumerate(strided):
             arrays[f"kinect_depth.{n:04d}.png"] = encode_image(frame.depth_mm, "png")
-        meta["depth"] = {"format": "png16", "unit": "mm", "stride": depth_stride}
+            if devices.kinect_parts:
+                arrays[f"kinect_parts.{n:04d}.png"] = encode_image(frame.parts, "png")
+        meta["depth"] = {"format": "png16", "unit": "mm", "stride": stride}
+        if devices.kinect_parts:
+            meta["parts"] = {"format": "png8", "names": ["none", *PART_NAMES], "stride": stride}
     return arrays, meta
 
 

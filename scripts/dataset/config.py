@@ -19,8 +19,10 @@ from typing import Any, Literal
 
 from avatarsim.avatar_models.config import ConfigError, from_data, read_toml, setting
 from avatarsim.avatar_models.generator import ACTIVITIES
+from avatarsim.avatar_models.mocap_dir import is_mocap_source
 from avatarsim.avatar_models.motion import FPS_RANGE
 from avatarsim.render_cams.fisheye.device import SCALE_RANGE
+from avatarsim.render_cams.kinect.placement import DEFAULT_HEIGHT_M
 from avatarsim.scripts.dataset.budget import check_budget
 
 SPLITS = ("train", "val", "test")
@@ -28,6 +30,7 @@ SPLIT_TOLERANCE = 1e-6
 SourceKind = Literal["builtin", "mocap"]
 VrNoise = Literal["none", "realistic"]
 KinectSensor = Literal["none", "kinect-v2", "azure-kinect"]
+KinectSkeleton = Literal["tracker", "oracle-noise"]
 ImageFormat = Literal["none", "jpeg", "png"]
 MocapSplitBy = Literal["clip", "performer"]
 
@@ -52,8 +55,9 @@ class SourceConfig:
         activities: activities to use (builtin: default all; mocap: a filter, default all).
         subjects: builtin: number of sampled subjects.
         windows: windows per subject x activity (builtin) or per clip (mocap).
-        path: mocap: the folder (relative to the config file's folder when read by
-            :func:`load_config`).
+        path: mocap: the folder, or one clip (relative to the config file's folder when
+            read by :func:`load_config`; ``mocap:RELATIVE/PATH``: inside the machine's mocap
+            folder, :mod:`avatar_models.mocap_dir`).
         split_by: mocap: ``"clip"`` or ``"performer"`` (the library's subject label).
     """
 
@@ -78,8 +82,16 @@ class DeviceSetConfig:
             (needs ``fisheye``).
         kinect: ``"none"``, ``"kinect-v2"`` or ``"azure-kinect"``: the skeleton with
             tracking states.
+        kinect_skeleton: ``"tracker"`` (tracked on the rendered depth, as the SDK does) or
+            ``"oracle-noise"`` (the true joints plus noise: not a sensor, labelled so in
+            every sample's JSON).
         kinect_depth: the Kinect's 16-bit depth images in millimetres, PNG (needs a
             ``kinect``).
+        kinect_parts: the body-part label image aligned with each depth image, 8-bit PNG
+            (part ``k + 1``: body17 joint ``k``, 0: no body; needs ``kinect_depth``).
+        kinect_yaw_deg: the sensor turned about the performer by this many degrees from its
+            set-up in front of them (0: front, 90: their left side, 180: behind).
+        kinect_height_m: the sensor's height above the floor.
         image_stride: images and depth of every ``image_stride``-th camera frame (rendering
             is most of a sample's time; 3 gives 10 Hz at the cameras' 30 Hz).
         image_scale: fisheye image size factor (1: 640 x 480).
@@ -93,7 +105,11 @@ class DeviceSetConfig:
     fisheye: bool = True
     fisheye_images: ImageFormat = "none"
     kinect: KinectSensor = "none"
+    kinect_skeleton: KinectSkeleton = "tracker"
     kinect_depth: bool = False
+    kinect_parts: bool = False
+    kinect_yaw_deg: float = setting(0.0, ge=-180.0, le=180.0)
+    kinect_height_m: float = setting(DEFAULT_HEIGHT_M, ge=0.2, le=2.5)
     image_stride: int = setting(3, ge=1)
     image_scale: float = setting(0.5, ge=SCALE_RANGE[0], le=SCALE_RANGE[1])
     physics: bool = True
@@ -126,10 +142,14 @@ def config_hash(config: DatasetConfig) -> str:
     """sha256 (hex) of the normalised config, keys sorted, each source's and device set's
     keys at their defaults left out: a key added later whose default keeps the old output
     (a new channel, off unless asked for) leaves the hash, and so resuming and verifying
-    datasets made before it, unchanged."""
+    datasets made before it, unchanged. ``kinect_skeleton`` always counts where there is a
+    Kinect: its default, the tracker, changed what such datasets hold."""
     data = config.as_dict()
     for key, table in (("sources", config.sources), ("devices", config.devices)):
         data[key] = [_without_defaults(t) for t in table]
+    for values, device in zip(data["devices"], config.devices, strict=True):
+        if device.kinect != "none":  # its skeleton was the oracle before the key existed
+            values["kinect_skeleton"] = device.kinect_skeleton
     text = json.dumps(data, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()
 
@@ -160,10 +180,11 @@ def load_config(path: str | Path) -> DatasetConfig:
         check_budget(config)
     except ConfigError as exc:
         raise ConfigError(f"{path}: {exc}") from None
-    # A relative mocap folder is relative to the config file, as a scenario's motion path is.
+    # A relative mocap folder is relative to the config file, as a scenario's motion path is;
+    # a mocap:RELATIVE/PATH one is inside the machine's mocap folder (resolved when planned).
     sources = tuple(
         replace(s, path=str(path.parent / s.path))
-        if s.path and not Path(s.path).is_absolute()
+        if s.path and not Path(s.path).is_absolute() and not is_mocap_source(s.path)
         else s
         for s in config.sources
     )
@@ -222,6 +243,8 @@ def _device(device: DeviceSetConfig, index: int) -> None:
         raise ConfigError(f"{where}.fisheye_images needs fisheye = true")
     if device.kinect_depth and device.kinect == "none":
         raise ConfigError(f"{where}.kinect_depth needs a kinect sensor")
+    if device.kinect_parts and not device.kinect_depth:
+        raise ConfigError(f"{where}.kinect_parts needs kinect_depth = true (it is aligned with it)")
     if not device.name.replace("-", "").isalnum():
         raise ConfigError(f"{where}.name must be letters, digits and '-', got {device.name!r}")
 

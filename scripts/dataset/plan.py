@@ -22,6 +22,7 @@ import numpy as np
 
 from avatarsim.avatar_models.errors import AvatarsimError
 from avatarsim.avatar_models.library import MotionLibrary
+from avatarsim.avatar_models.mocap_dir import is_mocap_source, resolve_mocap_source
 from avatarsim.scripts.dataset.config import SPLITS, ConfigError, DatasetConfig, SourceConfig
 
 WINDOW_SEEDS, DEVICE_SEEDS, SUBJECT_SEEDS, SPLIT_SEEDS = range(4)
@@ -115,18 +116,29 @@ def mocap_clips(source: SourceConfig) -> list:
     """The library clips of a mocap source, filtered by its activities, sorted by path.
 
     Raises:
-        ConfigError: a missing folder, no clips, or performers unknown with
+        ConfigError: a missing folder or clip, no mocap folder for a ``mocap:`` path, no
+        clips, or performers unknown with
         ``split_by = "performer"``.
     """
-    folder = Path(source.path)
-    if not folder.is_dir():
-        raise ConfigError(f"mocap source {folder}: no such folder")
     try:
-        library = MotionLibrary.index(folder)
+        mocap = is_mocap_source(source.path)
+        folder = resolve_mocap_source(source.path) if mocap else Path(source.path)
+    except AvatarsimError as exc:
+        raise ConfigError(f"mocap source {source.path}: {exc}") from None
+    one = folder if folder.is_file() else None  # a single clip
+    if one is None and not folder.is_dir():
+        raise ConfigError(f"mocap source {folder}: no such folder or clip")
+    try:
+        library = MotionLibrary.index(folder.parent if one else folder)
     except AvatarsimError as exc:
         raise ConfigError(f"mocap source {folder}: {exc}") from None
     clips = sorted(
-        (c for c in library if not source.activities or c.activity in source.activities),
+        (
+            c
+            for c in library
+            if (not source.activities or c.activity in source.activities)
+            and (one is None or Path(c.path) == one)
+        ),
         key=lambda c: str(c.path),
     )
     if not clips:

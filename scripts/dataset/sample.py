@@ -84,10 +84,7 @@ def make_sample(
         )
         arrays |= arrays_images
     if devices.kinect != "none":
-        depth_stride = devices.image_stride if devices.kinect_depth else 0
-        arrays_kinect, channels["kinect"] = kinect_channel(
-            humanoid, devices.kinect, seeds["kinect"], depth_stride
-        )
+        arrays_kinect, channels["kinect"] = kinect_channel(humanoid, devices, seeds["kinect"])
         arrays |= arrays_kinect
     if devices.physics:
         arrays_physics, channels["physics"] = physics_channel(humanoid)

@@ -74,7 +74,8 @@ def shard_bytes(samples: list[SampleEntries]) -> bytes:
 
 
 def decode_image(data: bytes) -> np.ndarray:
-    """An encoded image entry as (H, W, 3) uint8 RGB or (H, W) uint16 (16-bit depth)."""
+    """An encoded image entry as (H, W, 3) uint8 RGB, (H, W) uint16 (16-bit depth) or (H, W)
+    uint8 (body-part labels)."""
     image = cv2.imdecode(np.frombuffer(data, np.uint8), cv2.IMREAD_UNCHANGED)
     if image is None:
         raise ValueError("an image entry that does not decode")

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatarsim.render_cams.kinect import TrackingState, kinect_skeleton
+from avatarsim.render_cams.kinect import Kinect, TrackingState
 from avatarsim.render_cams.vr import FULL_BODY, HEADSET_AND_CONTROLLERS, REALISTIC_NOISE, VRSetup
 from avatarsim.render_cams.vr.dropouts import Dropouts
 from avatarsim.render_cams.vr.noise import Latency, PositionJitter
@@ -40,17 +40,20 @@ def setup(ctx: RunContext) -> VRSetup:
 
 
 def record_kinect(ctx: RunContext) -> None:
-    """The Kinect skeleton stream of the motion on the humanoid (``[devices] kinect``)."""
+    """The Kinect skeleton stream of the motion on the humanoid (``[devices] kinect``), from
+    ``[devices] kinect_skeleton``: tracked on the rendered depth, or the oracle (not a
+    sensor, labelled so in the run's info)."""
     spec = ctx.scenario.devices
-    stream = kinect_skeleton(
-        ctx.humanoid.motion, spec.kinect, seed=ctx.scenario.seed, body=ctx.humanoid.body
-    )
+    kinect = Kinect(spec.kinect, skeleton=spec.kinect_skeleton)
+    stream = kinect.sample(ctx.humanoid.motion, ctx.scenario.seed, ctx.humanoid.body).skeleton
     ctx.kinect_stream = stream
     ctx.metrics["kinect_tracked_frac"] = float(np.mean(stream.states == TrackingState.TRACKED))
     ctx.info.setdefault("devices", {})["kinect"] = {
         "device": spec.kinect,
         "rig": stream.rig,
         "samples": stream.n_samples,
+        "skeleton": stream.meta["skeleton"],
+        **{k: stream.meta[k] for k in ("skeleton_note",) if k in stream.meta},
     }
 
 

@@ -35,10 +35,10 @@ from avatarsim.avatar_models.rigs import body17_positions, load_rig
 from avatarsim.render_cams.device import motion_at_rate
 from avatarsim.render_cams.kinect.device import Kinect
 from avatarsim.render_cams.kinect.parts import N_PARTS
-from avatarsim.render_cams.kinect.placement import default_sensor_pose, performer_target
+from avatarsim.render_cams.kinect.placement import default_sensor_pose, orbit, performer_target
 from avatarsim.render_cams.kinect.skeleton import TrackingState
 from avatarsim.render_cams.kinect.tracker import DEFAULT_MODEL, load_tracker
-from avatarsim.render_cams.kinect.training import orbit, render_training_frames
+from avatarsim.render_cams.kinect.training import render_training_frames
 from avatarsim.render_cams.vr import VRSetup
 from avatarsim.sim.humanoid import humanoid_for
 from avatarsim.synthesis.movebox import MoveBox

@@ -1,22 +1,22 @@
 """The body-part tracker on rendered depth: joint error against the truth, facing away,
-frames with nobody, NaN depth, and reproducible training."""
+frames with nobody, a body half out of the frame, NaN depth, and reproducible training."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from avatarsim.avatar_models.body17 import MIRROR
+from avatarsim.avatar_models.body17 import INDEX, MIRROR
 from avatarsim.avatar_models.generator import generate
 from avatarsim.avatar_models.rigs import body17_positions, load_rig
 from avatarsim.render_cams.device import motion_at_rate
 from avatarsim.render_cams.kinect.depth import BODY_INDEX_NONE, DepthFrame
 from avatarsim.render_cams.kinect.device import Kinect
-from avatarsim.render_cams.kinect.placement import default_sensor_pose, performer_target
+from avatarsim.render_cams.kinect.placement import default_sensor_pose, orbit, performer_target
 from avatarsim.render_cams.kinect.sensors import get_sensor
 from avatarsim.render_cams.kinect.skeleton import TrackingState
 from avatarsim.render_cams.kinect.tracker import load_tracker, track
-from avatarsim.render_cams.kinect.training import TrackerTrainingConfig, orbit, train_tracker
+from avatarsim.render_cams.kinect.training import TrackerTrainingConfig, train_tracker
 from tests.render_cams.kinect_builders import t_pose
 
 WALK = generate("walk", duration_s=1.0, fps=30.0, seed=100)  # a subject never trained on
@@ -69,6 +69,47 @@ def test_frames_with_nobody_or_only_nan_depth_are_not_tracked():
         stream = track(frames, sensor, np.eye(4), tracker)
         assert np.all(stream.states == TrackingState.NOT_TRACKED)
         assert not stream.frame_dict(0)["body_tracked"]
+
+
+def test_a_body_half_out_of_the_frame_loses_what_it_cannot_see(recwarn):
+    """The sensor turned about its own vertical axis by half its field of view, so that the
+    T-posed performer's centre sits on the image's right edge and the left arm is out of
+    the frame. Nothing in the tracker knows the frame's edges: the left wrist, with no pixel
+    in the image, is NotTracked in every frame, and so is every rig joint built on it; the
+    other out-of-frame left-arm joints are lost or implausible (measured: the shoulder
+    Inferred, the elbow found on the torso's edge, tens of cm off), never where they are;
+    the joints inside the frame are still tracked; no NaN and no warning leaves it."""
+    sensor = get_sensor("kinect-v2")
+    motion = t_pose(6)
+    front = default_sensor_pose(motion)
+    pose = front.copy()
+    pose[:3, :3] = _about_z(np.arctan(0.5 * sensor.width / sensor.K[0, 0])) @ front[:3, :3]
+    stream = Kinect(sensor_pose=pose).sample(motion, seed=0).skeleton
+    rig = load_rig(stream.rig)
+    idx = rig.body17_indices()
+    true = body17_positions(motion)
+    cam = (true - pose[:3, 3]) @ pose[:3, :3]
+    u = sensor.K[0, 0] * cam[..., 0] / cam[..., 2] + sensor.K[0, 2]  # (T, 17) image column
+    assert np.all(u[:, INDEX["l_wrist"]] > sensor.width + 300)  # far out of the frame
+    states = stream.states[:, idx]
+    assert np.all(states[:, INDEX["l_wrist"]] == TrackingState.NOT_TRACKED)
+    for name in ("HandLeft", "HandTipLeft", "ThumbLeft", "WristLeft"):
+        assert np.all(stream.states[:, rig.skeleton.index(name)] == TrackingState.NOT_TRACKED)
+    err = np.linalg.norm(stream.positions[:, idx] - true, axis=-1)
+    for name in ("l_shoulder", "l_elbow"):
+        j = INDEX[name]
+        assert u[0, j] > sensor.width
+        lost_or_off = (states[:, j] != TrackingState.TRACKED) | (err[:, j] > 0.15)
+        assert lost_or_off.all(), (name, states[:, j], err[:, j])
+    inside = u < sensor.width - 40
+    assert (states[inside] == TrackingState.TRACKED).mean() > 0.75
+    assert np.all(np.isfinite(stream.positions)) and np.all(np.isfinite(stream.orientations))
+    assert not [w for w in recwarn if issubclass(w.category, RuntimeWarning)]
+
+
+def _about_z(angle: float) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
 def test_nan_pixels_in_a_body_are_skipped_not_propagated():

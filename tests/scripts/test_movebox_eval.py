@@ -14,7 +14,7 @@ from typer.testing import CliRunner
 
 from avatarsim.avatar_models.generator import generate
 from avatarsim.avatar_models.rigs import load_rig
-from avatarsim.render_cams.kinect import TrackingState, kinect_skeleton
+from avatarsim.render_cams.kinect import Kinect, TrackingState
 from avatarsim.scripts.cli import app
 from avatarsim.scripts.movebox_eval import mean_cm, shown_tracked, summarise
 from tests.synthesis.movebox.conftest import AUDIO_DIR
@@ -40,7 +40,7 @@ def write_skeleton_recording(stream, folder: Path) -> Path:
 
 @pytest.fixture(scope="module")
 def recorded_stream():
-    return kinect_skeleton(generate("wave", duration_s=1.0, fps=30.0, seed=2), "kinect-v2", seed=2)
+    return Kinect().sample(generate("wave", duration_s=1.0, fps=30.0, seed=2), seed=2).skeleton
 
 
 def test_builtin_numbers_story_and_recorded_take(tmp_path, recorded_stream):

@@ -48,6 +48,20 @@ def test_kinect_render_writes_depth_in_millimetres(tmp_path):
     assert abs(np.median(body) / 1e3 - placed) < 0.3
 
 
+def test_the_skeleton_is_tracked_unless_the_oracle_is_asked_for_and_then_labelled(tmp_path):
+    for skeleton, label in (("tracker", None), ("oracle-noise", "not a sensor")):
+        out = tmp_path / skeleton
+        args = ["render", "kinect-v2", "builtin:wave", "--out", str(out), "--duration-s", "0.1"]
+        result = runner.invoke(app, [*args, "--kinect-skeleton", skeleton])
+        assert result.exit_code == 0, result.output
+        record = json.loads((out / "recording.json").read_text())
+        frame = json.loads(sorted((out / "skeleton").glob("*.json"))[0].read_text())
+        assert record["skeleton"] == skeleton
+        for labelled in (record, frame):
+            note = labelled.get("skeleton_note")
+            assert (note is None) if label is None else note.startswith(label)
+
+
 def test_sensor_pose_and_frame_range_options(tmp_path):
     out = tmp_path / "k"
     args = ["render", "azure-kinect", "builtin:walk", "--out", str(out)]
@@ -108,6 +122,7 @@ def test_bad_ranges_and_placements_exit_2(tmp_path):
         ("azure-kinect", ["--start", "1", "--end", "0.5"], "after --start"),
         ("fisheye", ["--end", "soon"], "seconds or 'end'"),
         ("fisheye", ["--ring-offset", "0.5,0,0"], "within"),
+        ("kinect-v2", ["--kinect-skeleton", "truth"], "must be one of"),
     ]
     for device, extra, message in cases:
         args = ["render", device, "builtin:walk", "--out", str(tmp_path), *extra]

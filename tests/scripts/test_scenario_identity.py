@@ -32,6 +32,21 @@ def test_what_is_measured_changes_the_hash(tmp_path):
     assert len(hashes) == 3
 
 
+def test_the_kinect_skeleton_source_counts_only_with_a_kinect(tmp_path):
+    sc = load_scenario(write_scenario(tmp_path, "a", tables="[devices]\nvr = true\n"))
+    assert sc.devices.kinect is None
+
+    def with_devices(**changes):
+        return dataclasses.replace(sc, devices=dataclasses.replace(sc.devices, **changes))
+
+    oracle = with_devices(kinect_skeleton="oracle-noise")
+    assert scenario_hash(oracle) == scenario_hash(sc)
+    kinect = with_devices(kinect="kinect-v2")
+    assert scenario_hash(with_devices(kinect="kinect-v2", kinect_skeleton="oracle-noise")) != (
+        scenario_hash(kinect)
+    )
+
+
 def test_a_scenario_with_its_motion_file_hashes_alike_in_any_checkout(tmp_path):
     here = tmp_path / "one"
     write_scenario(here, "a", motion='source = "clip.bvh"')

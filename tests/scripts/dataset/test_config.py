@@ -1,6 +1,7 @@
 from __future__ import annotations
 
 from dataclasses import field, fields, make_dataclass, replace
+from pathlib import Path
 
 import pytest
 
@@ -79,3 +80,17 @@ def test_a_key_added_later_at_its_default_leaves_the_hash():
     assert config_hash(replace(config, devices=(with_new,))) == config_hash(config)
     switched_on = replace(with_new, new_channel=True)
     assert config_hash(replace(config, devices=(switched_on,))) != config_hash(config)
+
+
+def test_a_kinect_dataset_of_the_oracle_skeleton_is_not_taken_for_a_tracked_one():
+    """Hashes of the configs as the version before ``kinect_skeleton`` computed them (its
+    Kinect skeletons were the oracle's): a config with a Kinect hashes otherwise now, so its
+    old shards neither resume nor verify; one without (the shipped controllerpose-small)
+    keeps its hash."""
+    assert config_hash(from_dict(TINY)) != (
+        "3037dbfb6aa0cfe3253906a7ec112ce17b1ed5c921f2eae3d4bc028755d640ac"
+    )
+    shipped = Path(__file__).parents[3] / "scripts" / "datasets" / "controllerpose-small.toml"
+    assert config_hash(load_config(shipped)) == (
+        "76fd492f3ab920076b6e571d7cbceaddeb5776061620dd1efbdb727b2f5076a1"
+    )

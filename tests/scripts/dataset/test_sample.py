@@ -9,12 +9,14 @@ from avatarsim.avatar_models.body17 import INDEX
 from avatarsim.avatar_models.generator import Subject, generate
 from avatarsim.avatar_models.rigs import body17_positions
 from avatarsim.scripts.dataset.channels import kinect_channel, physics_channel
-from avatarsim.scripts.dataset.config import config_hash, from_dict
+from avatarsim.scripts.dataset.config import DeviceSetConfig, config_hash, from_dict
 from avatarsim.scripts.dataset.plan import plan_samples
 from avatarsim.scripts.dataset.sample import make_sample
 from avatarsim.scripts.dataset.shards import read_samples, shard_bytes
 from avatarsim.sim.humanoid import humanoid_for
 from tests.scripts.dataset.builders import TINY
+
+KINECT_V2 = DeviceSetConfig(name="k", kinect="kinect-v2")
 
 
 @pytest.fixture(scope="module")
@@ -84,9 +86,9 @@ def test_kinect_positions_follow_the_body_along_the_world_axes(wave):
     """The same body moved 0.8 m along +X and 0.3 m along -Y in the world (the sensor set up
     again in front of it, the same seed): its tracked joints move by exactly that, axis by
     axis, and sit on the ground truth's joints."""
-    here, _ = kinect_channel(_moved(wave, [0.0, 0.0, 0.0]), "kinect-v2", seed=5)
+    here, _ = kinect_channel(_moved(wave, [0.0, 0.0, 0.0]), KINECT_V2, seed=5)
     moved_humanoid = _moved(wave, [0.8, -0.3, 0.0])
-    there, _ = kinect_channel(moved_humanoid, "kinect-v2", seed=5)
+    there, _ = kinect_channel(moved_humanoid, KINECT_V2, seed=5)
     tracked = (here["kinect_state"] == 2) & (there["kinect_state"] == 2)
     assert tracked.mean() > 0.5
     shift = (there["kinect_pos"] - here["kinect_pos"])[tracked]  # (n, 3)

@@ -44,6 +44,7 @@ EXPECTED = {  # the README's dataset table: key -> (dtype, shape)
     "fisheye_image.{camera}.{n:04d}.png": ("uint8", (120, 160, 3)),
     "kinect_depth_frames.npy": ("int32", (N,)),
     "kinect_depth.{n:04d}.png": ("uint16", (424, 512)),
+    "kinect_parts.{n:04d}.png": ("uint8", (424, 512)),
     "contact.npy": ("bool", (T, 2)),
     "penetration_m.npy": ("float32", (T,)),
     "skate_m_s.npy": ("float32", (T, 2)),
@@ -53,17 +54,17 @@ EXPECTED = {  # the README's dataset table: key -> (dtype, shape)
 def _pattern(key: str) -> str:
     """The README's name of an entry: camera and frame number as placeholders."""
     key = re.sub(r"^fisheye_image\.[^.]+\.\d{4}\.", "fisheye_image.{camera}.{n:04d}.", key)
-    return re.sub(r"^kinect_depth\.\d{4}\.", "kinect_depth.{n:04d}.", key)
+    return re.sub(r"^kinect_(depth|parts)\.\d{4}\.", r"kinect_\1.{n:04d}.", key)
 
 
 @pytest.fixture(scope="module")
 def every_channel(tmp_path_factory):
     """One shard of 0.2 s samples with every channel: VR with trackers, fisheye keypoints and
-    PNG images, Kinect V2 skeleton and depth, physics labels."""
+    PNG images, Kinect V2 skeleton, depth and part labels, physics labels."""
     root = tmp_path_factory.mktemp("wds")
     devices = [
         {"name": "all", "trackers": True, "fisheye_images": "png", "kinect": "kinect-v2",
-         "kinect_depth": True, "image_scale": 0.25},
+         "kinect_depth": True, "kinect_parts": True, "image_scale": 0.25},
     ]  # fmt: skip
     sources = [{"kind": "builtin", "activities": ["wave"], "subjects": 3}]
     config = write_config(

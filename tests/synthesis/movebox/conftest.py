@@ -1,4 +1,5 @@
-"""Built-in takes and their noise-free Kinect streams, and the speech samples of
+"""A built-in take, its Kinect streams (tracked on the rendered depth, as MoveBox receives
+them, and the exact joints for the retargeting's own error), and the speech samples of
 ``../shared/audio`` (skipped when absent, as ``../shared/mocap``)."""
 
 from __future__ import annotations
@@ -8,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from avatarsim.avatar_models.generator import generate
-from avatarsim.render_cams.kinect import kinect_skeleton
+from avatarsim.render_cams.kinect import Kinect, kinect_skeleton
 from tests.conftest import MOCAP_DIR, require
 
 SENSORS = ("kinect-v2", "azure-kinect")
@@ -22,13 +23,17 @@ def box_truth():
 
 @pytest.fixture(scope="session")
 def clean_kinect(box_truth):
-    """Noise-free skeleton streams of the box take, by sensor."""
+    """Noise-free skeleton streams of the box take, by sensor: the true joints on the Kinect
+    rig (no sensor), to measure the retargeting alone."""
     return {s: kinect_skeleton(box_truth, s, noise=None) for s in SENSORS}
 
 
 @pytest.fixture(scope="session")
-def noisy_kinect(box_truth):
-    return {s: kinect_skeleton(box_truth, s, seed=0) for s in SENSORS}
+def tracked_kinect(box_truth):
+    """The ``Kinect`` device's skeleton streams of the box take (tracked on its depth)."""
+    streams = {s: Kinect(s).sample(box_truth, seed=0).skeleton for s in SENSORS}
+    assert all(k.meta["skeleton"] == "tracker" for k in streams.values())
+    return streams
 
 
 @pytest.fixture(scope="session")

@@ -20,8 +20,8 @@ def vr_stream(box_truth):
     return VRSetup().sample(box_truth, seed=0)
 
 
-def test_step_equals_run(noisy_kinect, box_truth, vr_stream):
-    synth = MoveBox(noisy_kinect["kinect-v2"], box_truth.skeleton)
+def test_step_equals_run(tracked_kinect, box_truth, vr_stream):
+    synth = MoveBox(tracked_kinect["kinect-v2"], box_truth.skeleton)
     batch = synth.run(vr_stream)
     synth.reset()
     steps = [synth.step(TrackingFrame.from_stream(vr_stream, i)) for i in range(60)]
@@ -29,8 +29,8 @@ def test_step_equals_run(noisy_kinect, box_truth, vr_stream):
     assert np.array_equal(np.stack([s.root_pos for s in steps]), batch.root_pos[:60])
 
 
-def test_no_kinect_frame_after_a_tick_changes_it(noisy_kinect, box_truth, vr_stream):
-    kinect = noisy_kinect["azure-kinect"]
+def test_no_kinect_frame_after_a_tick_changes_it(tracked_kinect, box_truth, vr_stream):
+    kinect = tracked_kinect["azure-kinect"]
     cut = 1.0
     later = kinect.timestamps > cut
     changed = replace(kinect, positions=np.where(later[:, None, None], 5.0, kinect.positions))
@@ -41,8 +41,8 @@ def test_no_kinect_frame_after_a_tick_changes_it(noisy_kinect, box_truth, vr_str
     assert not np.array_equal(a.local_rot[~before], b.local_rot[~before])
 
 
-def test_lost_joints_with_nan_data_give_finite_poses(noisy_kinect, box_truth, vr_stream):
-    kinect = noisy_kinect["kinect-v2"]
+def test_lost_joints_with_nan_data_give_finite_poses(tracked_kinect, box_truth, vr_stream):
+    kinect = tracked_kinect["kinect-v2"]
     states = kinect.states.copy()
     states[10:40, :12] = TrackingState.NOT_TRACKED  # the upper body leaves the view
     positions = np.where((states == TrackingState.NOT_TRACKED)[..., None], np.nan, kinect.positions)
@@ -51,8 +51,8 @@ def test_lost_joints_with_nan_data_give_finite_poses(noisy_kinect, box_truth, vr
     assert np.isfinite(out.local_rot).all() and np.isfinite(out.root_pos).all()
 
 
-def test_unusable_streams_raise(noisy_kinect, box_truth):
-    kinect = noisy_kinect["kinect-v2"]
+def test_unusable_streams_raise(tracked_kinect, box_truth):
+    kinect = tracked_kinect["kinect-v2"]
     empty = replace(kinect, timestamps=kinect.timestamps[:0], states=kinect.states[:0])
     with pytest.raises(SynthesisError, match="no frame"):
         MoveBox(empty, box_truth.skeleton)
@@ -67,30 +67,30 @@ def test_registry_says_which_devices_entry_to_enable(box_truth):
         build("movebox", inputs)
 
 
-def test_record_is_the_stream_on_the_display_clock(noisy_kinect, box_truth):
-    kinect = noisy_kinect["kinect-v2"]
+def test_record_is_the_stream_on_the_display_clock(tracked_kinect, box_truth):
+    kinect = tracked_kinect["kinect-v2"]
     motion = MoveBox(kinect, box_truth.skeleton).record(30.0)
     assert motion.fps == 30.0
     assert abs(motion.duration_s - (kinect.timestamps[-1] - kinect.timestamps[0])) < 1 / 30
 
 
-def test_registry_drives_a_resized_avatar_for_a_foreign_rig(noisy_kinect):
+def test_registry_drives_a_resized_avatar_for_a_foreign_rig(tracked_kinect):
     from avatarsim.avatar_models.measure import standing_height
     from avatarsim.avatar_models.rigs import load_rig
 
     inputs = MethodInputs(
-        lambda: None, 1.62, load_rig("cmu").skeleton, kinect=noisy_kinect["kinect-v2"]
+        lambda: None, 1.62, load_rig("cmu").skeleton, kinect=tracked_kinect["kinect-v2"]
     )
     synth = build("movebox", inputs)
     assert synth.name == "movebox" and synth.skeleton.name == "avatar"
     assert standing_height(synth.skeleton) == pytest.approx(1.62)
 
 
-def test_root_steps_with_kinect_frames_unless_smoothed(noisy_kinect, box_truth, vr_stream):
+def test_root_steps_with_kinect_frames_unless_smoothed(tracked_kinect, box_truth, vr_stream):
     """The paper smooths rotations only (§III-A1): at 90 Hz each 30 Hz Kinect frame's root is
     shown unchanged on about three ticks; ``smooth_root`` (beyond the paper) moves it every
     tick."""
-    kinect = noisy_kinect["kinect-v2"]
+    kinect = tracked_kinect["kinect-v2"]
     shown = vr_stream.timestamps > kinect.timestamps[0]
     n_frames = np.count_nonzero(kinect.timestamps <= vr_stream.timestamps[-1])
     paper = MoveBox(kinect, box_truth.skeleton).run(vr_stream).root_pos[shown]
