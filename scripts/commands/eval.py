@@ -701,7 +701,7 @@ def register(app: typer.Typer) -> None:
             table.add_column(column)
         for split, results in (
             ("dataset", report["results"]),
-            ("real mocap", report["real_mocap"]),
+            (report["real_mocap_is"], report["real_mocap"]),
         ):
             for name, res in (results or {}).items():
                 table.add_row(
@@ -712,6 +712,13 @@ def register(app: typer.Typer) -> None:
                     str(res["frames"]),
                 )
         console.print(table)
+        paper = report["paper"]
         if report["no_vr_increase_pct"] is not None:
             console.print(f"without VR: {report['no_vr_increase_pct']:+.1f}% (paper: +25.5%)")
+        console.print(
+            f"paper (§5.3): {paper['mean_cm']} cm (SD {paper['sd_cm']}), "
+            f"{paper['limbs_mean_cm']} without hip+torso, on another protocol:"
+        )
+        for what, differs in report["paper_differs"].items():
+            console.print(f"  {what.replace('_', ' ')}: {differs}")
         emit_json(json_out, report)
