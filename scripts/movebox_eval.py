@@ -54,6 +54,7 @@ from avatarsim.render_cams.kinect import (
     read_kinect_skeleton,
 )
 from avatarsim.render_cams.kinect.sensors import KINECT_RATE_HZ, get_sensor
+from avatarsim.render_cams.kinect.skeleton import ORACLE_NOTE
 from avatarsim.render_cams.vr import VRSetup
 from avatarsim.scripts.method_score import score_method
 from avatarsim.sim.humanoid import Humanoid, humanoid_for
@@ -297,6 +298,7 @@ def run_movebox_eval(
         "method": {s: DEFAULT_ROLL[get_sensor(s).rig] for s in sensors},
     }
     out = {"takes": rows, "summary": summarise(rows, sensors), "roll": roll, "seed": seed}
+    out["kinect_skeleton"] = ORACLE_NOTE  # what kinect_skeleton streams are (every take's)
     if audio:
         out["lip_sync"] = lip_sync_scores(list(audio))
     return out

@@ -261,6 +261,7 @@ def run_movebox(library, out, wanted, per_source, duration, quick, audio, kinect
     results.update(library=library, quick=quick)
     for table in _movebox_tables(results):
         console.print(table)
+    console.print(f"Kinect skeleton: {results['kinect_skeleton']}")
     for name, row in results.get("lip_sync", {}).items():
         console.print(f"lip sync {escape(name)}: jaw vs RMS envelope r = {row['r_jaw_rms']:.3f}")
     results["story"] = write_story(out / "story", 2.0 if quick else 4.0, seed, (files or [None])[0])

@@ -64,6 +64,9 @@ def test_builtin_numbers_story_and_recorded_take(tmp_path, recorded_stream):
     assert "movebox retargeting (hinge roll, beyond the paper)" in text
     assert "movebox method (the paper's roll per sensor)" in text
     assert "builtin │ kinect-v2 │ rest" in text and "builtin │ azure-kinect │ sensor" in text
+    # The Kinect skeleton is the truth plus noise, not a tracker's output: said where reported.
+    assert payload["kinect_skeleton"].startswith("not a sensor: the true joints")
+    assert f"Kinect skeleton: {payload['kinect_skeleton']}" in text
     for sensor in ("kinect-v2", "azure-kinect"):
         row = payload["summary"]["builtin"][sensor]
         assert row["retarget_err_cm"]["noise_free"] < 1.0
