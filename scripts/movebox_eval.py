@@ -55,7 +55,7 @@ from avatarsim.render_cams.kinect import (
     kinect_skeleton,
     read_kinect_skeleton,
 )
-from avatarsim.render_cams.kinect.sensors import KINECT_RATE_HZ
+from avatarsim.render_cams.kinect.sensors import KINECT_RATE_HZ, get_sensor
 from avatarsim.render_cams.kinect.skeleton import ORACLE_NOTE
 from avatarsim.render_cams.kinect.tracker import SKELETON_SOURCE
 from avatarsim.render_cams.vr import VRSetup
@@ -69,12 +69,16 @@ from avatarsim.synthesis.movebox.mapping import mapping_for
 from avatarsim.synthesis.movebox.resize import avatar_for, resized, user_height_m
 from avatarsim.synthesis.movebox.retarget import ROLLS, Retargeting, twist_angle
 from avatarsim.synthesis.movebox.similarity import loop_points, seam_index
+from avatarsim.synthesis.movebox.synthesizer import DEFAULT_ROLL
 from avatarsim.synthesis.scoring import body17_errors_cm
 
 SENSORS = ("kinect-v2", "azure-kinect")
 ACTIVITIES = ("walk", "box", "wave", "squat")
 LIMB_BONES = tuple(f"Bip01 {s} {b}" for s in "LR" for b in ("UpperArm", "Forearm", "Thigh", "Calf"))
 LOOP_SEARCH_S = 1.0
+RETARGET_ROLL = "hinge"
+"""The roll of the ``retarget_err_cm`` numbers: the hinge roll, which goes beyond the paper
+(:data:`~synthesis.movebox.synthesizer.DEFAULT_ROLL`); the tables and the JSON name it."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -231,12 +235,12 @@ def evaluate_sensor(
     row = {
         "tracked_frames_frac": float(tracked.mean()),
         "retarget_err_cm": {
-            "noise_free": body17_err_cm(retargeted(clean, target, "hinge"), truth30, tracked),
-            "sensed": body17_err_cm(retargeted(sensed, target, "hinge"), truth30, tracked),
+            "noise_free": body17_err_cm(retargeted(clean, target, RETARGET_ROLL), truth30, tracked),
+            "sensed": body17_err_cm(retargeted(sensed, target, RETARGET_ROLL), truth30, tracked),
             "kinect_err_cm": kinect_err_cm(sensed, truth30, tracked),
             "resized_avatar": float("nan")
             if uniform is None
-            else body17_err_cm(retargeted(clean, uniform, "hinge"), truth30, tracked),
+            else body17_err_cm(retargeted(clean, uniform, RETARGET_ROLL), truth30, tracked),
         },
     }
     if take.own_avatar:
@@ -306,7 +310,11 @@ def run_movebox_eval(
         }
         if progress is not None:
             progress(i + 1, len(takes), take.label)
-    out = {"takes": rows, "summary": summarise(rows, sensors), "seed": seed}
+    roll = {
+        "retargeting": RETARGET_ROLL,
+        "method": {s: DEFAULT_ROLL[get_sensor(s).rig] for s in sensors},
+    }
+    out = {"takes": rows, "summary": summarise(rows, sensors), "roll": roll, "seed": seed}
     out["skeleton"] = skeleton if skeleton == SKELETON_SOURCE else f"{skeleton} ({ORACLE_NOTE})"
     if audio:
         out["lip_sync"] = lip_sync_scores(list(audio))

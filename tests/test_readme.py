@@ -4,6 +4,7 @@ the real mocap (blocks that read it skip without it, and fail under ``CI=true``)
 
 from __future__ import annotations
 
+import ast
 import os
 import re
 import subprocess
@@ -60,3 +61,18 @@ def test_readme_python_block_runs(block, tmp_path, request):
         [sys.executable, "-c", block], cwd=tmp_path, capture_output=True, text=True, env=env
     )
     assert run.returncode == 0, run.stderr[-3000:]
+
+
+def test_every_slow_test_is_in_the_readme_slow_table():
+    """Each test marked ``slow`` (never run by ``make test``; a decorator or a marked
+    parameter) is a row of the README's table of what only the slow tier checks."""
+    marked = {
+        node.name
+        for path in (README.parent / "tests").rglob("test_*.py")
+        for node in ast.walk(ast.parse(path.read_text()))
+        if isinstance(node, ast.FunctionDef)
+        and any("pytest.mark.slow" in ast.unparse(d) for d in node.decorator_list)
+    }
+    table = README.read_text().split("| slow test |", 1)[1].split("\n\n", 1)[0]
+    assert len(marked) >= 5
+    assert not [name for name in sorted(marked) if f"::{name}" not in table], marked

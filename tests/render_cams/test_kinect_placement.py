@@ -10,6 +10,7 @@ from avatarsim.avatar_models.body17 import INDEX
 from avatarsim.avatar_models.formats import load_motion
 from avatarsim.avatar_models.rigs import body17_positions
 from avatarsim.render_cams.kinect import TrackingState, kinect_skeleton
+from avatarsim.render_cams.kinect.depth import BODY_INDEX_NONE, KinectDepthCamera
 from avatarsim.render_cams.kinect.placement import (
     DEFAULT_HEIGHT_M,
     KinectPlacementError,
@@ -20,6 +21,7 @@ from avatarsim.render_cams.kinect.placement import (
     yaw_pitch_pose,
 )
 from avatarsim.render_cams.kinect.sensors import get_sensor
+from avatarsim.render_cams.scene import BodyScene
 from tests.render_cams.kinect_builders import t_pose, t_pose_walk
 
 NOT_TRACKED = TrackingState.NOT_TRACKED
@@ -86,6 +88,32 @@ def test_performer_walking_through_the_sensor_is_recorded():
         kinect_skeleton(t_pose(3), "kinect-v2", yaw_pitch_pose([0.0, 0.0, 1.0], 0.0))
     with pytest.raises(KinectPlacementError, match="below the floor"):
         kinect_skeleton(t_pose(3), "kinect-v2", yaw_pitch_pose([2.0, 0.0, -0.1], np.pi))
+
+
+def test_automatic_set_up_stands_on_a_tv_bench_measured_from_the_floor_in_its_depth():
+    """The automatic set-up puts the sensor 0.9 m above the floor (a TV-bench height, inside
+    Microsoft's 0.6-1.8 m placement guidance), measured as a Kinect SDK finds its floor
+    plane: the floor pixels of a clean depth frame back-projected through the intrinsics
+    and fitted by a plane in camera coordinates; the sensor's height is its distance to it."""
+    motion = t_pose(1)
+    sensor = get_sensor("kinect-v2")
+    scene = BodyScene(motion.skeleton)
+    try:
+        scene.update(motion, 0)
+        frame = KinectDepthCamera(sensor, default_sensor_pose(motion, sensor), None).capture(
+            scene, None
+        )
+    finally:
+        scene.close()
+    v, u = np.nonzero((frame.body_index == BODY_INDEX_NONE) & (frame.depth_mm > 0))  # floor
+    z = frame.depth_m[v, u]
+    K = sensor.K
+    points = np.stack([(u - K[0, 2]) / K[0, 0] * z, (v - K[1, 2]) / K[1, 1] * z, z], -1)
+    assert len(points) > 10_000
+    centre = points.mean(0)
+    normal = np.linalg.svd(points - centre, full_matrices=False)[2][-1]  # (3,) unit
+    assert abs(normal[1]) > 0.95  # world up is near the camera's y axis: pitched a little
+    assert abs(centre @ normal) == pytest.approx(0.9, abs=0.005)
 
 
 def test_yaw_and_pitch_pose():

@@ -53,6 +53,20 @@ def test_builtin_numbers_story_and_recorded_take(tmp_path, recorded_stream):
     result = runner.invoke(app, args)
     assert result.exit_code == 0, result.output
     payload = json.loads(js.read_text())
+    # Every table names its roll: the retargeting's hinge roll, which MoveBox's paper does not
+    # use (§IV-B1: the avatar's rest roll for Kinect V2, the sensor's own for Azure Kinect),
+    # and the method's paper roll per sensor.
+    assert payload["roll"] == {
+        "retargeting": "hinge",
+        "method": {"kinect-v2": "rest", "azure-kinect": "sensor"},
+    }
+    text = " ".join(result.output.split())
+    assert "movebox retargeting (hinge roll, beyond the paper)" in text
+    assert "movebox method (the paper's roll per sensor)" in text
+    assert "builtin │ kinect-v2 │ rest" in text and "builtin │ azure-kinect │ sensor" in text
+    # Which skeleton the Kinect reported is said where the numbers are: by default the tracker.
+    assert payload["skeleton"] == "tracker"
+    assert "Kinect skeleton: tracker" in text
     for sensor in ("kinect-v2", "azure-kinect"):
         row = payload["summary"]["builtin"][sensor]
         assert row["retarget_err_cm"]["noise_free"] < 1.0

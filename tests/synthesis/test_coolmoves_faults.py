@@ -77,10 +77,25 @@ def test_out_of_order_and_duplicate_timestamps(small_db, clean, reference):
 
 
 def test_streaming_skips_late_samples(small_db, clean):
+    """A sample stamped before one already seen is skipped: it returns the pose before it,
+    and the other samples give exactly the poses of the stream without the late ones."""
     faulty = OutOfOrder(swap_fraction=0.1).apply(clean, np.random.default_rng(2))
-    synth = CoolMoves(small_db, TEST_SUBJECT.height_m)
-    poses = [synth.step(TrackingFrame.from_stream(faulty, i)) for i in range(faulty.n_samples)]
-    assert all(np.isfinite(p.local_rot).all() and np.isfinite(p.root_pos).all() for p in poses)
+    t = faulty.timestamps
+    late = np.r_[False, t[1:] <= np.maximum.accumulate(t)[:-1]]
+    assert 5 <= late.sum() < 0.2 * late.size
+
+    def stepped(stream):
+        synth = CoolMoves(small_db, TEST_SUBJECT.height_m)
+        poses = [synth.step(TrackingFrame.from_stream(stream, i)) for i in range(stream.n_samples)]
+        return np.stack([p.root_pos for p in poses]), np.stack([p.local_rot for p in poses])
+
+    root, rot = stepped(faulty)
+    on_time_root, on_time_rot = stepped(faulty[np.flatnonzero(~late)])
+    held = np.maximum.accumulate(np.where(late, 0, np.arange(late.size)))  # last on-time index
+    np.testing.assert_array_equal(root[late], root[held[late]])
+    np.testing.assert_array_equal(rot[late], rot[held[late]])
+    np.testing.assert_array_equal(root[~late], on_time_root)
+    np.testing.assert_array_equal(rot[~late], on_time_rot)
 
 
 def test_no_tracking_at_all_still_gives_a_pose(small_db, clean):
