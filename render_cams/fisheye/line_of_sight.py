@@ -11,8 +11,8 @@ that path's entry is in the way:
 
 - from a rendered range image (:func:`render_cams.fisheye.keypoints.visibility`): the range
   seen at the joint's pixel is shorter than the joint's range minus its own depth;
-- from the geometry alone (:func:`occluded`, for paths that render nothing): a sample of the
-  ray between the camera and that entry lies inside any other segment.
+- from the geometry alone (:func:`occluded`, for paths that render nothing): the line from
+  the camera to that entry meets any other segment.
 
 Both are vectorised over frames and joints; :data:`STEP_M` is the sampling step.
 """
@@ -73,6 +73,38 @@ def own_depth(
     return np.where(run > 0, np.minimum((run - 1) * STEP_M, ranges), 0.0)
 
 
+def _segment_distance(p0, d1, q0, d2) -> np.ndarray:
+    """``(...)`` closest distance between segments ``p0 + s d1`` and ``q0 + t d2`` (``s, t`` in
+    ``[0, 1]``; arrays ``(..., 3)`` broadcasting), Ericson's clamped closed form."""
+    r = p0 - q0
+    a = np.einsum("...k,...k->...", d1, d1)
+    e = np.einsum("...k,...k->...", d2, d2)
+    b = np.einsum("...k,...k->...", d1, d2)
+    c = np.einsum("...k,...k->...", d1, r)
+    f = np.einsum("...k,...k->...", d2, r)
+    denom = a * e - b * b
+    safe_a, safe_e = np.maximum(a, 1e-12), np.maximum(e, 1e-12)
+    s = np.where(denom > 1e-12, np.clip((b * f - c * e) / np.maximum(denom, 1e-12), 0, 1), 0.0)
+    t = np.clip((b * s + f) / safe_e, 0.0, 1.0)
+    s = np.clip((b * t - c) / safe_a, 0.0, 1.0)
+    gap = p0 + s[..., None] * d1 - q0 - t[..., None] * d2
+    return np.linalg.norm(gap, axis=-1)
+
+
+def _crosses_box(p0, p1, half) -> np.ndarray:
+    """``(...)`` bool: segment ``p0 -> p1`` (box frame, ``(..., 3)``) meets the box of half
+    sizes ``half`` ``(..., 3)`` (slab test)."""
+    d = p1 - p0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t0, t1 = (-half - p0) / d, (half - p0) / d
+    flat = np.abs(d) < 1e-12  # parallel to a slab: inside it or never
+    inside = np.abs(p0) < half
+    lo = np.where(flat, np.where(inside, -np.inf, np.inf), np.minimum(t0, t1))
+    hi = np.where(flat, np.where(inside, np.inf, -np.inf), np.maximum(t0, t1))
+    enter, leave = np.max(lo, axis=-1), np.min(hi, axis=-1)
+    return (enter <= leave) & (leave >= 0.0) & (enter <= 1.0)
+
+
 def occluded(
     body: BodyDescription,
     positions: np.ndarray,
@@ -81,15 +113,29 @@ def occluded(
     joints: np.ndarray,
 ) -> np.ndarray:
     """``(T, J)`` bool: another segment cuts the line of sight from the camera to the joint
-    (arguments as :func:`own_depth`): a ray sample between the camera and the joint's own
-    limbs lies inside a segment that does not meet at the joint."""
-    n_t, n_j = joints.shape[:2]
-    ranges = np.linalg.norm(centres[:, None] - joints, axis=-1)
-    start = own_depth(body, positions, rotations, centres, joints) + STEP_M
-    n_k = max(int(np.ceil(ranges.max() / STEP_M)), 1)
-    share = (np.arange(n_k) + 0.5) / n_k  # (K,), the camera centre itself excluded
-    distances = start[..., None] + share * np.maximum(ranges - start, 0.0)[..., None]
-    points = _ray_samples(centres, joints, distances)
-    inside = inside_segments(body, positions, rotations, points.reshape(n_t, -1, 3))
-    inside = inside.reshape(n_t, n_j, n_k, -1) & ~own_segments(body)[None, :, None]
-    return np.any(inside, axis=(-1, -2))
+    (arguments as :func:`own_depth`): the segment from the camera to where the ray enters the
+    joint's own limbs meets a body segment that does not meet at the joint (capsules and
+    spheres by their axis distance, boxes by a slab test)."""
+    seg = body.segments
+    bodies = np.array([s.body for s in seg])
+    rot = rotations[:, bodies]  # (T, S, 3, 3)
+    origin = positions[:, bodies]  # (T, S, 3)
+    start = origin + np.einsum("tsab,sb->tsa", rot, np.stack([s.start for s in seg]))
+    end = origin + np.einsum("tsab,sb->tsa", rot, np.stack([s.end for s in seg]))
+    back = centres[:, None] - joints  # (T, J, 3)
+    ranges = np.linalg.norm(back, axis=-1)
+    depth = own_depth(body, positions, rotations, centres, joints) + STEP_M
+    entry = joints + back * (np.minimum(depth, ranges) / np.maximum(ranges, 1e-12))[..., None]
+    ray0 = centres[:, None, None]  # (T, 1, 1, 3)
+    ray = entry[:, :, None] - ray0  # (T, J, 1, 3)
+    radius = np.array([s.radius for s in seg])
+    hit = _segment_distance(ray0, ray, start[:, None], (end - start)[:, None]) < radius
+    is_box = np.array([s.shape == "box" for s in seg])
+    if np.any(is_box):
+        box_rot = rot[:, is_box] @ np.stack([s.box_rotation for s in seg if s.shape == "box"])
+        centre = start[:, is_box][:, None]  # (T, 1, B, 3)
+        local0 = np.einsum("tbka,tjbk->tjba", box_rot, ray0 - centre)  # R^T (p - c)
+        local1 = np.einsum("tbka,tjbk->tjba", box_rot, entry[:, :, None] - centre)
+        half = np.stack([s.half_extents for s in seg if s.shape == "box"])
+        hit[..., is_box] = _crosses_box(local0, local1, half)
+    return np.any(hit & ~own_segments(body)[None], axis=-1)
