@@ -151,6 +151,10 @@ class ErrorModelDetector:
     """
 
     name: ClassVar[str] = "error-model"
+    label: ClassVar[str] = (
+        "a fast approximation: a 2D detector's error model applied to the exact projections "
+        "of the true joints, no pixels read"
+    )
     error_scale: float = 1.5
     occluded_scale: float = 2.0
     miss_rate: float = 0.5

@@ -261,7 +261,11 @@ class FisheyeRig:
             "occluded_frames": {name: int(occluded[c].sum()) for c, name in enumerate(names)},
             "detector": None
             if self.detector is None
-            else {"name": self.detector.name, **asdict(self.detector)},
+            else {
+                "name": self.detector.name,
+                "label": self.detector.label,
+                **asdict(self.detector),
+            },
             "composites": {
                 controller: {
                     "frames_with_person": int(v.composite_detection.detected.any(axis=1).sum()),

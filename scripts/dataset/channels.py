@@ -142,7 +142,7 @@ def fisheye_channel(humanoid: Humanoid, seed: int) -> Channel:
         "keypoints": "projected (no images rendered; in_view occlusion-tested by a ray test "
         'against the body), then detected by the "error-model" detector (a fast approximation '
         "of a 2D detector; its confidence does not encode the drawn error)",
-        "detector": {"name": detector.name, **asdict(detector)},
+        "detector": {"name": detector.name, "label": detector.label, **asdict(detector)},
         "seed": seed,
         "views": view_names,
         "view_sizes": {
