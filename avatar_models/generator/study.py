@@ -29,10 +29,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from avatarsim.avatar_models.generator.curves import keyframes, smoothstep
 from avatarsim.avatar_models.generator.feet import FootTrack
-from avatarsim.avatar_models.generator.ik import axis_rotation
+from avatarsim.avatar_models.generator.ik import axis_rotation, twist_about
 from avatarsim.avatar_models.generator.plan import LimbTarget, Plan, Scene, realise
 from avatarsim.avatar_models.generator.poses import Y_AXIS, gaze, heading_rotation, trunk
 from avatarsim.avatar_models.generator.standing import home_ankles, leg_targets, reachable_root
@@ -51,6 +52,8 @@ MIN_PAUSE_S = 0.1
 ENGAGE_S = 0.5  # raising the hand from rest to its group's first sphere, and back
 HOLD_S, DOWN_S = (1.2, 2.5), (0.4, 0.9)  # lifted-leg hold and drop-down durations
 REST_HAND = (0.2, 0.1, -0.85)  # resting wrist from the shoulder, in arm lengths (88 % reach)
+MAX_FOREARM_TURN_RAD = np.radians(70.0)  # the avatar rig's forearm twist is +-80 deg
+REST_THUMB = np.array([1.0, 0.0, 0.0])  # the rig's rest (T-pose, palms down) thumb side
 SUPPORT_SHIFT = 0.048  # statures: pelvis over the support foot (as the one-leg balance)
 
 
@@ -255,4 +258,41 @@ def controllerpose_study(scene: Scene) -> Plan:
         wrist = shoulder + np.einsum("tab,tb->ta", chest, wrist - rest_shoulder)
         pole = np.einsum("tab,b->ta", chest, [0.0, sign, -1.0])  # elbow out and down
         plan.arms[side] = LimbTarget(wrist, pole)
+    for side, rotation in neutral_grip(scene, plan, chest, active).items():
+        plan.arms[side] = LimbTarget(plan.arms[side].position, plan.arms[side].pole, rotation)
     return plan
+
+
+def neutral_grip(
+    scene: Scene, plan: Plan, chest: np.ndarray, active: dict[str, np.ndarray]
+) -> dict[str, np.ndarray]:
+    """``{side: (T, 3, 3)}`` world hand rotations that hold a controller as VR users do: the
+    controller (the hand's rest forearm axis) turned from the forearm halfway to the chest's
+    forward axis while the hand works its spheres (``active`` ``{side: (T,)}`` in ``[0, 1]``,
+    a wrist bend of at most 45 deg), the thumb side up (the chest's up axis; blended towards
+    its forward axis as the hand points up or down, forward when it hangs); the IK gives the
+    turn about the forearm to the forearm (pronation/supination). Without it the two-bone IK
+    carries the rest pose's palm-down hand into every reach; the turn is kept within
+    :data:`MAX_FOREARM_TURN_RAD` of the IK's. ``chest``: ``(T, 3, 3)`` chest rotations.
+    """
+    sk = scene.skeleton
+    _, rotations = realise(scene, plan).fk()
+    ahead, up = chest[:, :, 0], chest[:, :, 2]  # (T, 3) chest forward and up
+    out = {}
+    for side in "LR":
+        hand = sk.index(f"Bip01 {side} Hand")
+        bone = sk.offsets[hand] / np.linalg.norm(sk.offsets[hand])  # rest forearm axis
+        forearm = rotations[:, hand] @ bone  # (T, 3): the rest hand is in line with it
+        point = forearm + active[side][:, None] * ahead
+        point /= np.linalg.norm(point, axis=1, keepdims=True)
+        hint = up + np.abs(np.einsum("ta,ta->t", up, point))[:, None] * ahead
+        thumb = hint - np.einsum("ta,ta->t", hint, point)[:, None] * point
+        thumb /= np.linalg.norm(thumb, axis=1, keepdims=True)
+        rest = np.stack([bone, REST_THUMB, np.cross(bone, REST_THUMB)], axis=1)
+        world = np.stack([point, thumb, np.cross(point, thumb)], axis=2)
+        relative = np.swapaxes(rotations[:, hand], -1, -2) @ world @ rest.T  # in the forearm
+        twist = twist_about(relative, bone)
+        angle = Rotation.from_matrix(twist).as_rotvec() @ bone
+        kept = axis_rotation(bone, np.clip(angle, -MAX_FOREARM_TURN_RAD, MAX_FOREARM_TURN_RAD))
+        out[side] = rotations[:, hand] @ relative @ np.swapaxes(twist, -1, -2) @ kept
+    return out

@@ -35,10 +35,17 @@ Per frame, vectorised over any leading axes (frames, cameras), for ``body17`` ke
   shoulder, elbow, wrist; legs: hip, knee, ankle, foot), the detector reports the left limb's
   keypoints as the right one's and back: the "inversion" error Ronchi & Perona (ICCV 2017)
   name as typical of bottom-up detectors. The rate is an assumption.
-- **Confidence** that tracks the error, as a heatmap's peak does: ``v`` times the keypoint's
-  OKS term of its localisation error (before any swap: a detector is as sure of a swapped limb
-  as of the right one), times log-normal noise ``exp(N(0, confidence_noise))``, clipped to
-  ``[0, 1]``; 0 for joints not reported.
+- **Confidence**: ``v`` times the *expected* OKS term of the joint's error distribution,
+  ``1 / (1 + c^2 / 4)`` with ``c = error_scale`` (``error_scale * occluded_scale`` when
+  occluded), times log-normal noise ``exp(N(0, confidence_noise))``, clipped to ``[0, 1]``; 0
+  for joints not reported. It depends on what the detector could know (visibility, where in
+  the lens, occlusion), never on the error actually drawn: a network fed these confidences
+  learns nothing about which keypoints are wrong that a real detector's confidence would
+  not tell it. Swapped limbs keep their confidences (a detector is as sure of a swapped limb
+  as of the right one).
+
+This is a fast approximation for keypoint-only datasets and tests; what it reports is labelled
+``"error-model"`` wherever it is stored.
 """
 
 from __future__ import annotations
@@ -130,7 +137,8 @@ class Detection:
 @dataclass(frozen=True)
 class ErrorModelDetector:
     """The ``"error-model"`` detector: the error model of a 2D keypoint detector, a fast
-    approximation from the exact projections (module docstring).
+    approximation from the exact projections, not a detector run on pixels (module
+    docstring).
 
     Attributes:
         error_scale: localisation error over COCO's annotator error (per axis, times
@@ -143,6 +151,10 @@ class ErrorModelDetector:
     """
 
     name: ClassVar[str] = "error-model"
+    label: ClassVar[str] = (
+        "a fast approximation: a 2D detector's error model applied to the exact projections "
+        "of the true joints, no pixels read"
+    )
     error_scale: float = 1.5
     occluded_scale: float = 2.0
     miss_rate: float = 0.5
@@ -160,6 +172,14 @@ class ErrorModelDetector:
         ``scale_px`` ``(...)`` and visibility ``visible`` ``(..., J)`` bool."""
         sigma = self.error_scale * BODY17_SIGMAS * np.asarray(scale_px)[..., None]
         return np.where(visible, sigma, self.occluded_scale * sigma)
+
+    def expected_oks(self, visible: np.ndarray) -> np.ndarray:
+        """``(..., J)`` the mean over the error distribution of COCO's OKS term (``k_i = 2
+        sigma_i``) of joints ``visible`` ``(..., J)`` bool: with per-axis error ``c sigma_i s``,
+        ``E[exp(-d^2 / (2 s^2 (2 sigma_i)^2))] = 1 / (1 + c^2 / 4)``, the same for every
+        joint and person size."""
+        c = np.where(visible, self.error_scale, self.error_scale * self.occluded_scale)
+        return 1.0 / (1.0 + 0.25 * c**2)
 
     def detect(self, image: np.ndarray, truth: ViewTruth, rng: np.random.Generator) -> Keypoints2D:
         """The :class:`~render_cams.fisheye.pose_detector.PoseDetector` protocol: what the
@@ -195,12 +215,11 @@ class ErrorModelDetector:
         error = rng.standard_normal(uv.shape) * sigma[..., None]
         missed = rng.random(in_image.shape) < self.miss_rate * (1.0 - np.asarray(score))
         swapped = rng.random((*found.shape, len(LIMB_PAIRS))) < self.swap_rate
-        # COCO's OKS term with k_i = 2 sigma_i (1 where no person, as the error is 0 there).
-        oks = np.exp(
-            -np.sum(error**2, axis=-1)
-            / np.maximum(2.0 * (2.0 * BODY17_SIGMAS * scale[..., None]) ** 2, 1e-12)
+        conf = (
+            score
+            * self.expected_oks(visible)
+            * np.exp(self.confidence_noise * rng.standard_normal(in_image.shape))
         )
-        conf = score * oks * np.exp(self.confidence_noise * rng.standard_normal(oks.shape))
         conf = np.clip(conf, 0.0, 1.0)
         reported = uv + error
         detected = in_image & found[..., None] & ~missed

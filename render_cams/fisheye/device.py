@@ -35,11 +35,11 @@ from avatarsim.render_cams.fisheye import bad_frames, occlusion
 from avatarsim.render_cams.fisheye.detector import ErrorModelDetector
 from avatarsim.render_cams.fisheye.keypoints import (
     confidence,
-    joint_thickness,
     project_joints,
     visibility,
     world_to_camera,
 )
+from avatarsim.render_cams.fisheye.line_of_sight import own_depth
 from avatarsim.render_cams.fisheye.model import FisheyeModel
 from avatarsim.render_cams.fisheye.pose2d import ControllerPose2D, controller_views
 from avatarsim.render_cams.fisheye.records import frame_record
@@ -149,9 +149,13 @@ class FisheyeRig:
         body = body_for_motion(sampled, body)
         cameras = controller_cameras(self.controllers, self.mount)
         poses = camera_poses(sampled, cameras)  # (T, C, 4, 4)
-        inside = inside_body(body, *sampled.fk(), poses[..., :3, 3])  # (T, C): lens covered
+        pose = sampled.fk()
+        inside = inside_body(body, *pose, poses[..., :3, 3])  # (T, C): lens covered
         joints = body17_positions(sampled)  # (T, 17, 3)
-        thickness = joint_thickness(body)
+        depth = np.stack(
+            [own_depth(body, *pose, poses[:, c, :3, 3], joints) for c in range(poses.shape[1])],
+            axis=1,
+        )  # (T, C, 17)
         # A stream added later (dark frames, then composite detections) leaves the earlier
         # ones as they were.
         rng_inject, rng_noise, rng_dark, rng_views = (
@@ -183,7 +187,7 @@ class FisheyeRig:
                     uv, in_image, joint_range = project_joints(
                         model, poses[t, c][None], joints[t][None]
                     )
-                    vis = visibility(uv[0], in_image[0], joint_range[0], range_m, thickness)
+                    vis = visibility(uv[0], in_image[0], joint_range[0], range_m, depth[t, c])
                     seen.append((t, c, uv[0], in_image[0], vis & ~inside[t, c]))
         elapsed = time.perf_counter() - start
 
@@ -257,7 +261,11 @@ class FisheyeRig:
             "occluded_frames": {name: int(occluded[c].sum()) for c, name in enumerate(names)},
             "detector": None
             if self.detector is None
-            else {"name": self.detector.name, **asdict(self.detector)},
+            else {
+                "name": self.detector.name,
+                "label": self.detector.label,
+                **asdict(self.detector),
+            },
             "composites": {
                 controller: {
                     "frames_with_person": int(v.composite_detection.detected.any(axis=1).sum()),

@@ -3,9 +3,10 @@
 Projection uses the camera's own model (:meth:`FisheyeModel.project`, equal to
 ``cv2.fisheye.projectPoints``), vectorised over frames and joints. A joint is *visible* when it
 projects inside the image and the rendered range at its pixel is not shorter than the joint's
-range minus the body's thickness there (a joint sits inside its limb, so the visible surface
-is up to one limb radius nearer): otherwise something else, usually the user's own arm or
-body, is in front of it.
+range minus its own depth along that ray (a joint sits inside its limbs, so the surface seen
+there is nearer by the ray's path through them,
+:func:`render_cams.fisheye.line_of_sight.own_depth`): otherwise something else, usually the
+user's own arm or body, is in front of it.
 
 Confidence is a heuristic of what a 2D detector reports (ControllerPose §4.3 feeds OpenPose
 confidences to its network): 1 at the image centre falling to 0.5 at the 90 deg image
@@ -17,7 +18,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from avatarsim.avatar_models.body import BodyDescription
 from avatarsim.render_cams.fisheye.model import HALF_PI, FisheyeModel
 
 OCCLUDED_CONFIDENCE = 0.1
@@ -46,37 +46,26 @@ def project_joints(
     return uv, in_image, np.linalg.norm(cam, axis=-1)
 
 
-def joint_thickness(body: BodyDescription) -> np.ndarray:
-    """``(17,)`` the largest radius of the segments carried by or ending at each body17 joint:
-    how far in front of a joint its own body surface can be."""
-    joints = body.rig.body17_indices(body.skeleton)
-    parents = body.skeleton.parents
-    out = np.zeros(len(joints))
-    for k, j in enumerate(joints):
-        radii = [s.radius for s in body.segments if s.body == j or s.body == parents[j]]
-        out[k] = max(radii, default=0.05)
-    return out
-
-
 def visibility(
     uv: np.ndarray,
     in_image: np.ndarray,
     joint_range: np.ndarray,
     range_image: np.ndarray,
-    thickness: np.ndarray,
+    depth: np.ndarray,
 ) -> np.ndarray:
     """``(J,)`` bool: joints of one frame not hidden behind other surfaces.
 
     Args:
         uv, in_image, joint_range: one frame of :func:`project_joints` (``(J, 2)``, ``(J,)``).
         range_image: ``(H, W)`` rendered range (0 where nothing was hit).
-        thickness: ``(J,)`` from :func:`joint_thickness`.
+        depth: ``(J,)`` each joint's own depth along its ray
+            (:func:`render_cams.fisheye.line_of_sight.own_depth`).
     """
     h, w = range_image.shape
     col = np.clip(np.rint(uv[:, 0]).astype(int), 0, w - 1)
     row = np.clip(np.rint(uv[:, 1]).astype(int), 0, h - 1)
     seen = range_image[row, col]
-    nearest_allowed = joint_range - thickness - DEPTH_SLACK_M
+    nearest_allowed = joint_range - depth - DEPTH_SLACK_M
     return in_image & ((seen == 0) | (seen >= nearest_allowed))
 
 

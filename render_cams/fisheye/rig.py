@@ -3,10 +3,14 @@
 ControllerPose §4.1 instruments each controller with one camera "on the upper ring" and one
 "mounted to the bottom of the grip", both looking back at the user, and reports that the two
 120 deg vertical fields of view composite to 185 deg: so their optical axes are 65 deg apart
-in pitch. Here each looks back along the controller's -X (towards the forearm and body),
-pitched up (ring) or down (grip) by 32.5 deg, with the image's x axis along the controller's
-+Y, so the image is upright when the controller is held level. Mounting offsets in the
-controller frame (+X pointing, +Y left, +Z up; see :mod:`render_cams.vr.placements`) are
+in pitch. Here each looks back along the controller's -X (towards the user), the ring camera
+pitched up by 20 deg and the grip camera down by 45 deg, with the image's x axis along the
+controller's +Y, so the image is upright when the controller is held level with its ring up
+(:mod:`render_cams.vr.placements`). The split of the 65 deg is our choice, not the paper's:
+held in front of the chest, a controller has the head less than 45 deg above its back axis
+and the feet up to 70 deg below, so the composite's 185 deg are centred 12.5 deg below it.
+Mounting offsets in the controller frame (+X pointing, +Y left, +Z up; see
+:mod:`render_cams.vr.placements`) are
 plausible values for a Quest 2 controller chosen here, not measurements: the ring 6 cm above
 and 2 cm in front of the palm centre, the grip's bottom 6 cm below and 2 cm behind it (the
 palm closes round the middle of a grip about 11 cm long). A mount 8 cm below put the camera
@@ -30,7 +34,9 @@ from avatarsim.render_cams.vr import Attachment, attachment_poses, nominal_attac
 
 COMPOSITE_VERTICAL_FOV_DEG = 185.0  # ControllerPose §4.1
 CAMERA_VERTICAL_FOV_DEG = 120.0  # ControllerPose §4.1
-PITCH_RAD = np.radians(0.5 * (COMPOSITE_VERTICAL_FOV_DEG - CAMERA_VERTICAL_FOV_DEG))
+PITCH_APART_RAD = np.radians(COMPOSITE_VERTICAL_FOV_DEG - CAMERA_VERTICAL_FOV_DEG)
+RING_PITCH_RAD = np.radians(20.0)  # module docstring
+GRIP_PITCH_RAD = RING_PITCH_RAD - PITCH_APART_RAD
 RING_OFFSET_M = np.array([0.02, 0.0, 0.06])
 GRIP_BOTTOM_OFFSET_M = np.array([-0.02, 0.0, -0.06])
 CONTROLLERS = ("left_controller", "right_controller")
@@ -96,8 +102,8 @@ class Mount:
 
     ring_offset_m: tuple[float, float, float] = tuple(RING_OFFSET_M)
     grip_offset_m: tuple[float, float, float] = tuple(GRIP_BOTTOM_OFFSET_M)
-    ring_pitch_rad: float = float(PITCH_RAD)
-    grip_pitch_rad: float = float(-PITCH_RAD)
+    ring_pitch_rad: float = float(RING_PITCH_RAD)
+    grip_pitch_rad: float = float(GRIP_PITCH_RAD)
 
     def __post_init__(self) -> None:
         for name in ("ring_offset_m", "grip_offset_m"):
@@ -145,10 +151,10 @@ def camera_poses(motion: Motion, cameras: Sequence[ControllerCamera]) -> np.ndar
     return poses
 
 
-def inside_body(
+def inside_segments(
     body: BodyDescription, positions: np.ndarray, rotations: np.ndarray, points: np.ndarray
 ) -> np.ndarray:
-    """``(T, N)`` bool: point ``n`` of frame ``t`` lies inside a body segment.
+    """``(T, N, S)`` bool: point ``n`` of frame ``t`` lies inside body segment ``s``.
 
     Args:
         positions: ``(T, J, 3)`` global joint positions; rotations ``(T, J, 3, 3)``.
@@ -173,7 +179,15 @@ def inside_body(
         box_rot = np.stack([s.box_rotation for s in seg])
         in_box = np.einsum("sba,tnsb->tnsa", box_rot, local - start)
         inside = np.where(is_box, np.all(np.abs(in_box) < half, axis=-1), inside)
-    return np.any(inside, axis=-1)
+    return inside
+
+
+def inside_body(
+    body: BodyDescription, positions: np.ndarray, rotations: np.ndarray, points: np.ndarray
+) -> np.ndarray:
+    """``(T, N)`` bool: point ``n`` of frame ``t`` lies inside a body segment (arguments as
+    :func:`inside_segments`)."""
+    return np.any(inside_segments(body, positions, rotations, points), axis=-1)
 
 
 def check_cameras_outside(body: BodyDescription, motion: Motion, poses: np.ndarray) -> None:

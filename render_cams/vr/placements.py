@@ -13,8 +13,11 @@ offsets back, it stores each tracker's offset to the avatar's joint at a T-pose 
   tracking origin is), looking along +X with +Z up.
 - ``left_controller`` / ``right_controller``: in the palm, 8 cm from the wrist joint along the
   forearm, with the controller's +X (its pointing axis) along the rig's rest forearm
-  (elbow -> wrist) and +Z as close to world up as that allows; a relaxed power grip, as if
-  pointing the controller where the hand points.
+  (elbow -> wrist) and +Z (towards its tracking ring, ControllerPose §4.1's "upper ring") on
+  the thumb side of the hand: a power grip closes round the grip's handle across the palm, the
+  ring above the thumb and the grip's bottom below the little finger. The thumb side is taken
+  as the body's forward axis at rest, which it is for a T-pose with the palms down and for
+  arms hanging with the palms in; a rest forearm along that axis falls back to world up.
 - ``left_foot_tracker`` / ``right_foot_tracker``: on the instep, 6 cm in front of the ankle
   joint and 2 cm above it, level and facing forward.
 - ``back_tracker``: on the lower back, 10 cm behind and 5 cm above the pelvis joint, facing
@@ -54,16 +57,16 @@ _HANDS = {"left_controller": "l", "right_controller": "r"}
 
 
 def _grip(skeleton: Skeleton, side: str) -> Attachment:
-    """Controller in the ``side`` hand, aligned with the rig's rest forearm."""
+    """Controller in the ``side`` hand: +X along the rig's rest forearm, +Z the thumb side."""
     rig = identify_rig(skeleton)
     rest = skeleton.rest_positions()
     elbow, wrist = (rest[skeleton.index(rig.body17[f"{side}_{j}"])] for j in ("elbow", "wrist"))
     forward = (wrist - elbow) / np.linalg.norm(wrist - elbow)
-    # Controller +Z: world up with its forearm component removed; a vertical rest forearm
-    # (arms down) has none, so fall back to the body's forward axis.
-    up = np.array([0.0, 0.0, 1.0])
+    # Controller +Z: the thumb side, the body's forward axis at rest with its forearm
+    # component removed; a rest forearm pointing forward has none, so fall back to world up.
+    up = np.array([1.0, 0.0, 0.0])
     if abs(forward @ up) > 0.9:
-        up = np.array([1.0, 0.0, 0.0])
+        up = np.array([0.0, 0.0, 1.0])
     up = up - (up @ forward) * forward
     up /= np.linalg.norm(up)
     frame = np.stack([forward, np.cross(up, forward), up], axis=1)  # columns: x, y, z

@@ -377,10 +377,10 @@ def register(app: typer.Typer) -> None:
         ] = None,
         ring_pitch: Annotated[
             float | None,
-            typer.Option(help="Ring camera pitch in degrees above looking back (32.5)."),
+            typer.Option(help="Ring camera pitch in degrees above looking back (20)."),
         ] = None,
         grip_pitch: Annotated[
-            float | None, typer.Option(help="Grip camera pitch in degrees (-32.5: looking down).")
+            float | None, typer.Option(help="Grip camera pitch in degrees (-45: looking down).")
         ] = None,
         unit: UnitOpt = None,
         seed: SeedOpt = 0,

@@ -6,13 +6,13 @@ whose motion and body every channel shares, and a channel seed.
 - :func:`vr_channel`: headset + controllers (+ trackers) at 90 Hz with the validity mask.
 - :func:`fisheye_channel`: the controller cameras' body17 keypoints, *projected*: the
   cameras' poses and lens model are the :class:`render_cams.fisheye.device.FisheyeRig`'s,
-  but no image is rendered, so ``in_view`` means "in the image and the lens not inside the
-  body" and is NOT occlusion-tested (a joint behind the user's own arm counts as in view);
-  the rendered visibility of :func:`render_cams.fisheye.keypoints.visibility` needs a range
-  image per frame, which a keypoints-only dataset does not render. ``fisheye_uv`` and
-  ``fisheye_conf`` are what a 2D detector reports
-  (:class:`render_cams.fisheye.detector.ErrorModelDetector`, its default error model,
-  seeded): the exact projections are ``fisheye_uv_projected``.
+  but no image is rendered, so ``in_view`` ("in the image, the lens not inside the body and
+  nothing in the way") is occlusion-tested by a ray test against the body's segments
+  (:func:`render_cams.fisheye.line_of_sight.occluded`) instead of a range image. ``fisheye_uv``
+  and ``fisheye_conf`` are what the ``"error-model"`` detector reports
+  (:class:`render_cams.fisheye.detector.ErrorModelDetector`, a fast approximation of a 2D
+  detector from the exact projections, seeded; its confidence does not encode the error it
+  draws): the exact projections are ``fisheye_uv_projected``.
 - :func:`kinect_channel`: the Kinect skeleton with tracking states (tracked on the rendered
   depth by default).
 - :func:`fisheye_image_channel` and the Kinect's depth and body-part labels
@@ -38,6 +38,7 @@ from avatarsim.render_cams.device import motion_at_rate
 from avatarsim.render_cams.fisheye.detector import ErrorModelDetector
 from avatarsim.render_cams.fisheye.device import CAMERA_RATE_HZ, FisheyeRig
 from avatarsim.render_cams.fisheye.keypoints import confidence, project_joints, world_to_camera
+from avatarsim.render_cams.fisheye.line_of_sight import occluded
 from avatarsim.render_cams.fisheye.pose2d import controller_views
 from avatarsim.render_cams.fisheye.rig import camera_poses, controller_cameras, inside_body
 from avatarsim.render_cams.kinect import Kinect, default_sensor_pose, get_sensor
@@ -103,19 +104,25 @@ def fisheye_channel(humanoid: Humanoid, seed: int) -> Channel:
     sampled = motion_at_rate(humanoid.motion, rig.rate_hz)
     cameras = controller_cameras(rig.controllers, rig.mount)
     poses = camera_poses(sampled, cameras)  # (Tc, C, 4, 4)
-    covered = inside_body(humanoid.body, *sampled.fk(), poses[..., :3, 3])  # (Tc, C)
+    pose = sampled.fk()
+    covered = inside_body(humanoid.body, *pose, poses[..., :3, 3])  # (Tc, C)
     joints = body17_positions(sampled)  # (Tc, 17, 3)
     n_frames, n_cams = poses.shape[:2]
     uv, in_image, _ = project_joints(
         rig.model, poses.reshape(-1, 4, 4), np.repeat(joints, n_cams, axis=0)
     )
     uv = uv.reshape(n_frames, n_cams, -1, 2)
-    in_view = in_image.reshape(n_frames, n_cams, -1) & ~covered[..., None]
+    in_image = in_image.reshape(n_frames, n_cams, -1) & ~covered[..., None]
+    hidden = np.stack(
+        [occluded(humanoid.body, *pose, poses[:, c, :3, 3], joints) for c in range(n_cams)],
+        axis=1,
+    )  # (Tc, C, 17)
+    in_view = in_image & ~hidden
     detector = ErrorModelDetector()
     score = confidence(rig.model, uv, in_view)
-    detection = detector.detect_projected(uv, in_view, in_view, score, np.random.default_rng(seed))
+    detection = detector.detect_projected(uv, in_image, in_view, score, np.random.default_rng(seed))
     views = controller_views(
-        rig.model, cameras, uv, in_view, in_view, score, ~covered, detector,
+        rig.model, cameras, uv, in_image, in_view, score, ~covered, detector,
         np.random.default_rng([seed, 1]),
     )  # fmt: skip
     view_names = [f"{c}/{kind}" for c in views for kind in ("composite", "torso")]
@@ -136,9 +143,10 @@ def fisheye_channel(humanoid: Humanoid, seed: int) -> Channel:
         "rate_hz": rig.rate_hz,
         "cameras": [c.name for c in cameras],
         "model": rig.model.as_dict(),
-        "keypoints": "projected (in_view not occlusion-tested; no images rendered), then "
-        'detected by the "error-model" detector (a fast approximation)',
-        "detector": {"name": detector.name, **asdict(detector)},
+        "keypoints": "projected (no images rendered; in_view occlusion-tested by a ray test "
+        'against the body), then detected by the "error-model" detector (a fast approximation '
+        "of a 2D detector; its confidence does not encode the drawn error)",
+        "detector": {"name": detector.name, "label": detector.label, **asdict(detector)},
         "seed": seed,
         "views": view_names,
         "view_sizes": {

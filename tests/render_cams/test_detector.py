@@ -1,5 +1,5 @@
-"""The 2D keypoint detector's error model: its statistics are the configured ones, and its
-confidences fall as its errors grow."""
+"""The 2D keypoint detector's error model (a fast approximation): its statistics are the
+configured ones, and its confidences do not encode the errors it draws."""
 
 import numpy as np
 import pytest
@@ -63,17 +63,25 @@ def test_missed_joints_follow_visibility_and_swaps_their_rate():
     np.testing.assert_allclose(detection.uv[legs, l_foot], uv[legs, INDEX["r_foot"]])
 
 
-def test_confidence_falls_as_the_error_grows():
+def test_confidence_is_independent_of_the_drawn_error_given_visibility():
+    """Within visible joints and within occluded ones, the rank correlation of confidence with
+    the error actually drawn is ~0 (an error model whose confidence is the drawn error's OKS
+    gives about -0.87): the confidence tells which joints are hard to see, not which draws are
+    wrong. Occluded joints get the lower confidence their larger error distribution implies."""
     detector = ErrorModelDetector(swap_rate=0.0, miss_rate=0.0)
+    visible = np.arange(17) % 2 == 0
     for seed in (0, 1, 2):
-        uv, detection = run(detector, seed=seed, n=2000)
+        uv, detection = run(detector, visible=visible, seed=seed, n=2000)
         error = np.linalg.norm(detection.uv - uv, axis=-1) / (BODY17_SIGMAS * SCALE_PX)
-        rho = spearmanr(error.ravel(), detection.confidence.ravel()).statistic
-        # Measured -0.872 on seeds 0-2 (confidence noise 0.2); a detector whose confidence
-        # ignored the error would give 0.
-        assert rho < -0.75
+        for group in (visible, ~visible):
+            rho = spearmanr(error[:, group].ravel(), detection.confidence[:, group].ravel())
+            # Measured |rho| <= 0.013 over seeds 0-9 and both groups (16000-18000 draws each).
+            assert abs(rho.statistic) < 0.03, (seed, rho.statistic)
+        mean_conf = [detection.confidence[:, g].mean() for g in (visible, ~visible)]
+        # 1 / (1 + c^2 / 4) for c = 1.5 and 3.0, times E[exp(N(0, 0.2))] = exp(0.02)
+        np.testing.assert_allclose(mean_conf, np.exp(0.02) * np.array([0.64, 4 / 13]), rtol=0.01)
     # Lower visibility scales confidence down.
-    _, dim = run(detector, score=0.5, n=2000)
+    _, dim = run(detector, visible=visible, score=0.5, n=2000)
     assert dim.confidence.mean() == pytest.approx(0.5 * detection.confidence.mean(), rel=0.05)
 
 

@@ -8,10 +8,10 @@ from avatarsim.avatar_models.generator import generate
 from avatarsim.avatar_models.rigs import body17_positions
 from avatarsim.render_cams.fisheye.keypoints import (
     confidence,
-    joint_thickness,
     project_joints,
     visibility,
 )
+from avatarsim.render_cams.fisheye.line_of_sight import own_depth
 from avatarsim.render_cams.fisheye.model import FisheyeModel
 from avatarsim.render_cams.fisheye.render import FisheyeRenderer
 from avatarsim.render_cams.fisheye.rig import (
@@ -49,19 +49,19 @@ def test_hand_between_camera_and_knee_occludes_the_knee(setup):
     joints = body17_positions(motion[[0]])
     knee = joints[0, INDEX["l_knee"]]
     camera = _looking_at(knee + [0.8, 0.15, 0.1], knee)
-    thickness = joint_thickness(scene.body)
+    depth = own_depth(scene.body, positions, rotations, camera[None, :3, 3], joints)[0]
     uv, in_image, joint_range = project_joints(model, camera[None], joints)
 
     scene.set_pose(positions[0], rotations[0])
     _, range_m = renderer.render(camera)
-    before = visibility(uv[0], in_image[0], joint_range[0], range_m, thickness)
+    before = visibility(uv[0], in_image[0], joint_range[0], range_m, depth)
 
     hand = scene.body.skeleton.index(scene.body.rig.body17["l_wrist"])
     moved = positions[0].copy()
     moved[hand] = 0.5 * (knee + camera[:3, 3])  # the hand and its controller grip
     scene.set_pose(moved, rotations[0])
     _, range_m = renderer.render(camera)
-    after = visibility(uv[0], in_image[0], joint_range[0], range_m, thickness)
+    after = visibility(uv[0], in_image[0], joint_range[0], range_m, depth)
 
     knee_i = INDEX["l_knee"]
     assert before[knee_i] and not after[knee_i]

@@ -146,7 +146,10 @@ def test_composite_is_185_by_150_degrees(params):
     # angles are measured from its pixels' rays, not from the constants that built it.
     coverage = params.coverage()
     assert coverage["horizontal_deg"] == pytest.approx(150.0, abs=1.0)
-    assert coverage["vertical_deg"] == pytest.approx(COMPOSITE_VERTICAL_FOV_DEG, abs=4.0)
+    # The lens angles add to 185 deg at the cameras; measured on the 43 cm stitch surface
+    # from between the cameras, parallax (centres 13 cm apart) takes a few degrees off the
+    # edges: 182 deg with the cameras pitched +-32.5 deg, 180.5 with +20/-45.
+    assert coverage["vertical_deg"] == pytest.approx(COMPOSITE_VERTICAL_FOV_DEG, abs=5.0)
 
 
 def test_a_filtered_camera_leaves_the_blend(params):

@@ -64,11 +64,12 @@ def test_nominal_placements_on_the_rest_pose():
     }
     for name, xyz in expected.items():
         np.testing.assert_allclose(pos[stream.device(name)], xyz, atol=1e-12, err_msg=name)
-    # Controllers point along the outstretched arm with their top up; the back tracker faces -X.
+    # Controllers point along the outstretched arm with their top (the ring) on the thumb side:
+    # forward in a T-pose with the palms down. The back tracker faces -X.
     axes = quat.to_matrix(q)
     for name, forward in (("left_controller", [0, 1, 0]), ("right_controller", [0, -1, 0])):
         np.testing.assert_allclose(axes[stream.device(name)][:, 0], forward, atol=1e-12)
-        np.testing.assert_allclose(axes[stream.device(name)][:, 2], [0, 0, 1], atol=1e-12)
+        np.testing.assert_allclose(axes[stream.device(name)][:, 2], [1, 0, 0], atol=1e-12)
     np.testing.assert_allclose(axes[stream.device("back_tracker")][:, 0], [-1, 0, 0], atol=1e-12)
 
 

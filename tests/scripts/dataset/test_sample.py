@@ -40,13 +40,17 @@ def test_ground_truth_and_devices_agree(first_sample):
     gap = np.linalg.norm(arrays["vr_pos"][::3, hmd] - head, axis=-1)
     assert np.median(gap) < 0.2
     # four controller cameras at 30 Hz; a detector's keypoints: confidences in (0, 1] where
-    # detected, 0 elsewhere, only joints in view detected (a left/right swap may report a
-    # limb on the side not in view), near but not at the projections
+    # detected, 0 elsewhere, only joints in the image detected (occluded ones too, guessed;
+    # a left/right swap may report a limb on the side not in the image), near but not at
+    # the projections; in view: in the image and not occluded, some in-image joints hidden
     uv, conf, seen = arrays["fisheye_uv"], arrays["fisheye_conf"], arrays["fisheye_in_view"]
     found, exact = arrays["fisheye_detected"], arrays["fisheye_uv_projected"]
     assert uv.shape == exact.shape == (t, 4, 17, 2) and conf.shape == seen.shape == (t, 4, 17)
     middle = [INDEX[j] for j in ("head", "neck", "pelvis")]
-    assert found.any() and not np.any(found[..., middle] & ~seen[..., middle])
+    in_image = (np.abs(exact[..., 0] - 319.5) < 320) & (np.abs(exact[..., 1] - 239.5) < 240)
+    in_image &= ~arrays["fisheye_lens_covered"][..., None]
+    assert found.any() and not np.any(found[..., middle] & ~in_image[..., middle])
+    assert not np.any(seen & ~in_image) and np.any(in_image & ~seen)
     assert np.all((conf[found] > 0) & (conf[found] <= 1)) and np.all(conf[~found] == 0)
     assert np.all(np.isfinite(uv)) and np.all(np.isfinite(exact[seen]))
     error = np.linalg.norm(uv - exact, axis=-1)[found]
